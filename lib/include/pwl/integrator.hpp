@@ -1,0 +1,44 @@
+#pragma once
+// The one concept every time integrator of pwl models (after Boost.Odeint's stepper concept):
+// it holds a state (t, x, x') of a GapStructure and advances it to a requested time, telling an
+// observer about every step it takes. The precise-integration stepper and the Runge-Kutta
+// reference integrators are interchangeable behind it, so analysis code never knows which one
+// produced the motion it studies.
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "pwl/types.hpp"
+
+namespace pwl {
+
+// Called after every internal step with the time and the state at the end of the step. The
+// references are valid only during the call: copy what you keep.
+using StepObserver = std::function<void(double t, const Vector& x, const Vector& v)>;
+
+struct IntegratorStats {
+  long steps = 0;            // accepted steps
+  long rejected_steps = 0;   // adaptive integrators: steps redone with a smaller size
+  long rhs_evaluations = 0;  // adaptive integrators: right-hand-side calls
+  long kink_events = 0;      // spring openings/closings located (kink-located integrators)
+  long lcp_pivots = 0;       // precise integration: LCP pivots summed over the steps
+};
+
+class Integrator {
+ public:
+  virtual ~Integrator() = default;
+  virtual std::string name() const = 0;
+  virtual Index dofs() const = 0;
+  // Sets time, displacements and velocities (the spring forces follow from x).
+  virtual void set_state(double t, const Vector& x, const Vector& v) = 0;
+  virtual double time() const = 0;
+  virtual const Vector& position() const = 0;
+  virtual const Vector& velocity() const = 0;
+  // Integrates to exactly t_end (>= time()). Fixed-step integrators require t_end to lie on
+  // their step grid and throw InputError otherwise. Throws DivergenceError when the state stops
+  // being finite or leaves the integrator's divergence bound.
+  virtual void advance_to(double t_end, const StepObserver& observer = nullptr) = 0;
+  virtual IntegratorStats stats() const = 0;
+};
+
+}  // namespace pwl
