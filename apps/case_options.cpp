@@ -1,0 +1,94 @@
+#include "case_options.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "pwl/errors.hpp"
+#include "pwl/pim_integrator.hpp"
+#include "pwl/reference_integrator.hpp"
+
+namespace pwl::app {
+
+void add_case_options(CLI::App& c, CaseOptions& o) {
+  c.add_option("--figure", o.figure, "Start from one of the paper's 5-DOF cases: 4a, 4b, 5, 6")
+      ->check(CLI::IsMember({"4a", "4b", "5", "6"}));
+  c.add_option("--n", o.masses, "Number of masses")->check(CLI::PositiveNumber);
+  c.add_option("--alpha", o.alpha, "Contact stiffness ratio k2/k1 (one value or one per mass)")
+      ->delimiter(',');
+  c.add_option("--zeta", o.zeta, "Damping ratio c/sqrt(k1 m)");
+  c.add_option("--gap", o.gap, "Nondimensional gap of every mass's spring");
+  c.add_option("--gaps", o.gaps, "Gaps per mass, comma separated (overrides --gap)")
+      ->delimiter(',');
+  c.add_option("--theta", o.theta, "Forcing frequency ratio ω/ω0");
+  c.add_option("--loads", o.loads, "Load amplitudes Q per mass, comma separated")->delimiter(',');
+  c.add_option("--periods", o.periods, "Forcing periods to integrate")->check(CLI::PositiveNumber);
+  c.add_option("--skip-periods", o.skip_periods, "Leading periods left out of the output")
+      ->check(CLI::NonNegativeNumber);
+  c.add_option("--steps-per-period", o.steps_per_period, "PIM steps per forcing period")
+      ->check(CLI::PositiveNumber);
+  c.add_option("--dt", o.dt, "PIM step (must divide the forcing period)");
+  c.add_option("--method", o.method, "Integrator: pim, dopri5 or rkf78")
+      ->check(CLI::IsMember({"pim", "dopri5", "rkf78"}));
+  c.add_option("--tol", o.tolerance, "Relative and absolute tolerance of dopri5/rkf78");
+  c.add_flag("--locate-kinks", o.locate_kinks,
+             "dopri5/rkf78: end a step exactly at every spring opening or closing");
+  c.add_option("--lcp", o.lcp_solver, "PIM's LCP solver: block-pivoting or lemke")
+      ->check(CLI::IsMember({"block-pivoting", "lemke"}));
+}
+
+NondimensionalChain CaseOptions::chain() const {
+  NondimensionalChain c;
+  if (!figure.empty()) c = paper_five_dof_case(figure);
+  c.masses = masses;
+  if (!alpha.empty()) c.alpha = alpha;
+  if (!std::isnan(zeta)) c.zeta = zeta;
+  if (!gaps.empty()) {
+    c.gap = gaps;
+  } else if (!std::isnan(gap)) {
+    c.gap = {gap};
+  }
+  if (!std::isnan(theta)) c.theta = theta;
+  if (!loads.empty()) {
+    c.amplitude = loads;
+  } else if (masses != 5) {
+    // The paper's alternating Q = (1, -1, 1, ...) for any number of masses.
+    c.amplitude.clear();
+    for (int i = 0; i < masses; ++i) c.amplitude.push_back(i % 2 == 0 ? 1.0 : -1.0);
+  }
+  return c;
+}
+
+double CaseOptions::step(double period) const {
+  if (dt == 0.0) return period / steps_per_period;
+  if (!(dt > 0.0)) throw InputError(fmt::format("--dt = {} must be positive", dt));
+  const double ratio = period / dt;
+  if (std::abs(ratio - std::round(ratio)) > 1e-9 * ratio) {
+    throw InputError(fmt::format(
+        "--dt = {} does not divide the forcing period {} ({} steps); use --steps-per-period", dt,
+        period, ratio));
+  }
+  return period / std::round(ratio);
+}
+
+std::unique_ptr<Integrator> CaseOptions::integrator(const GapStructure& structure,
+                                                    double period) const {
+  std::unique_ptr<Integrator> result;
+  if (method == "pim") {
+    PimOptions p;
+    p.step = step(period);
+    p.lcp_solver = lcp_solver;
+    result = make_pim_integrator(structure, p);
+  } else {
+    ReferenceOptions r;
+    r.method = parse_runge_kutta_method(method);
+    r.relative_tolerance = r.absolute_tolerance = tolerance;
+    r.locate_kinks = locate_kinks;
+    r.max_step = period / 8;
+    result = make_reference_integrator(structure, r);
+  }
+  result->set_state(0.0, Vector::Zero(structure.dofs()), Vector::Zero(structure.dofs()));
+  return result;
+}
+
+}  // namespace pwl::app

@@ -1,0 +1,44 @@
+#pragma once
+// The flags that describe one case of the nondimensional chain and how to integrate it, shared by
+// the subcommands that run a single case (simulate, analyze).
+#include <CLI/CLI.hpp>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pwl/chain_builders.hpp"
+#include "pwl/integrator.hpp"
+
+namespace pwl::app {
+
+struct CaseOptions {
+  std::string figure;  // a paper preset ("4a", "4b", "5", "6"); flags override it
+  int masses = 5;
+  std::vector<double> alpha;  // one value or one per mass
+  // NaN: not given (the preset or the default applies).
+  double zeta = std::numeric_limits<double>::quiet_NaN();
+  double gap = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> gaps;  // per mass, overrides gap
+  double theta = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> loads;  // Q per mass (or one value)
+  int periods = 1000;
+  int skip_periods = 0;  // periods left out of the written output
+  int steps_per_period = 200;
+  double dt = 0.0;             // overrides steps_per_period; must divide the period
+  std::string method = "pim";  // pim | dopri5 | rkf78
+  double tolerance = 1e-10;
+  bool locate_kinks = false;
+  std::string lcp_solver = "block-pivoting";
+
+  // The chain these flags describe (the preset, then each given flag).
+  NondimensionalChain chain() const;
+  // The step the PIM uses: period / steps_per_period, or dt when it divides the period.
+  double step(double period) const;
+  // The integrator the flags name, with its state at rest at t = 0.
+  std::unique_ptr<Integrator> integrator(const GapStructure& structure, double period) const;
+};
+
+void add_case_options(CLI::App& command, CaseOptions& options);
+
+}  // namespace pwl::app
