@@ -1,6 +1,7 @@
 // The precise-integration stepper against closed-form solutions: exact (to rounding) whenever no
 // spring changes state inside a step, second order in η when one does.
 #include <catch2/catch.hpp>
+#include <Eigen/Eigenvalues>
 
 #include <cmath>
 #include <vector>
@@ -244,4 +245,60 @@ TEST_CASE("PIM reports motion that blows up", "[pim]") {
   integrator->set_state(0.0, Vector::Zero(1), Vector::Zero(1));
   CHECK_THROWS_AS(integrator->advance_to(1000.0), DivergenceError);
   CHECK(integrator->time() < 100.0);
+}
+
+TEST_CASE("The PIM tangent map is the Jacobian of the step map", "[pim][tangent]") {
+  // Over one forcing period of the period-7 case (many contacts), the product of the step
+  // Jacobians matches central differences of the map itself. The map is piecewise affine, so
+  // differences with a perturbation that keeps every active set agree to rounding.
+  const NondimensionalChain c = paper_five_dof_case("4b");
+  const GapStructure s = make_chain(c);
+  const double T = c.period(), eta = T / 200;
+  auto run = make_pim_integrator(s, pim(eta));
+  run->set_state(0.0, Vector::Zero(5), Vector::Zero(5));
+  run->advance_to(100 * T);  // onto the attractor
+  const Vector x0 = run->position(), v0 = run->velocity();
+  Matrix tangent = Matrix::Identity(10, 10);
+  run->advance_with_tangent(101 * T, tangent);
+  const Vector end_x = run->position();
+
+  auto image = [&](const Vector& state) {
+    auto i = make_pim_integrator(s, pim(eta));
+    i->set_state(100 * T, state.head(5), state.tail(5));
+    i->advance_to(101 * T);
+    Vector out(10);
+    out << i->position(), i->velocity();
+    return out;
+  };
+  Vector base(10);
+  base << x0, v0;
+  // The restart reproduces the run (time counted from another origin rounds differently).
+  CHECK((image(base).head(5) - end_x).norm() < 1e-12);
+  const double h = 1e-7;
+  Matrix differences(10, 10);
+  for (int j = 0; j < 10; ++j) {
+    Vector plus = base, minus = base;
+    plus[j] += h;
+    minus[j] -= h;
+    differences.col(j) = (image(plus) - image(minus)) / (2 * h);
+  }
+  INFO("tangent:\n" << tangent << "\ndifferences:\n" << differences);
+  CHECK((tangent - differences).cwiseAbs().maxCoeff() < 1e-6 * tangent.cwiseAbs().maxCoeff());
+  CHECK(tangent.cwiseAbs().maxCoeff() > 1e-3);  // not trivially zero
+}
+
+TEST_CASE("Without contacts the tangent map is exp(H t)", "[pim][tangent]") {
+  GapStructure s = single_mass(2.0, 0.3, 5.0);
+  s.springs.push_back({0, -1, 1.0, 10.0, 100.0});
+  s.loads.push_back({0, 1.0, 1.1, 0.0});
+  auto run = make_pim_integrator(s, pim(0.05));
+  run->set_state(0.0, Vector::Zero(1), Vector::Zero(1));
+  Matrix tangent = Matrix::Identity(2, 2);
+  run->advance_with_tangent(10.0, tangent);
+  // For x'' + 0.15 x' + 2.5 x = f: the determinant of exp(H t) is exp(trace(H) t) = exp(-0.15 t).
+  CHECK(tangent.determinant() == Approx(std::exp(-0.15 * 10.0)).epsilon(1e-12));
+  // The eigenvalues are exp(λ t) with λ = -0.075 ± i sqrt(2.5 - 0.075²): modulus exp(-0.75).
+  const Eigen::VectorXcd mu = tangent.eigenvalues();
+  CHECK(std::abs(mu[0]) == Approx(std::exp(-0.75)).epsilon(1e-12));
+  CHECK(std::abs(mu[1]) == Approx(std::exp(-0.75)).epsilon(1e-12));
 }

@@ -53,6 +53,17 @@ class PimIntegrator final : public Integrator {
   const Vector& velocity() const override { return velocity_; }
 
   void advance_to(double t_end, const StepObserver& observer) override {
+    advance(t_end, nullptr, observer);
+  }
+
+  void advance_with_tangent(double t_end, Matrix& tangent, const StepObserver& observer) override {
+    advance(t_end, &tangent, observer);
+  }
+
+  IntegratorStats stats() const override { return stats_; }
+
+ private:
+  void advance(double t_end, Matrix* tangent, const StepObserver& observer) {
     const double eta = propagator_.step_size();
     const double span = (t_end - propagator_.time()) / eta;
     const double whole = std::round(span);
@@ -65,6 +76,7 @@ class PimIntegrator final : public Integrator {
     const long count = static_cast<long>(whole);
     for (long k = 0; k < count; ++k) {
       propagator_.step();
+      if (tangent != nullptr) propagator_.apply_step_tangent(*tangent);
       stats_.lcp_pivots += propagator_.last_lcp_pivots();
       if (observer) {
         sync();
@@ -75,9 +87,6 @@ class PimIntegrator final : public Integrator {
     sync();
   }
 
-  IntegratorStats stats() const override { return stats_; }
-
- private:
   void sync() {
     position_ = propagator_.position();
     velocity_ = propagator_.velocity();

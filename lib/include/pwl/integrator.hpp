@@ -39,6 +39,13 @@ class Integrator {
   // being finite or leaves the integrator's divergence bound.
   virtual void advance_to(double t_end, const StepObserver& observer = nullptr) = 0;
   virtual IntegratorStats stats() const = 0;
+
+  // Advances to t_end like advance_to and multiplies `tangent` (2n x p, rows in state order
+  // [x; x']) by the Jacobian of the motion from time() to t_end, for Lyapunov exponents and
+  // Floquet multipliers. Integrators without an exact tangent map throw InputError; the default
+  // is that.
+  virtual void advance_with_tangent(double t_end, Matrix& tangent,
+                                    const StepObserver& observer = nullptr);
 };
 
 }  // namespace pwl
