@@ -11,8 +11,8 @@
 //
 // Method references: Dormand & Prince, J. Comput. Appl. Math. 6 (1980) 19-26 (dopri5);
 // Fehlberg, NASA TR R-287 (1968) (rkf78); event location as in Hairer, Nørsett & Wanner,
-// Solving ODEs I, §II.6 (dense output) and Shampine & Thompson, "Event location for ordinary differential
-// equations", Comput. Math. Appl. 39 (2000) 43-54.
+// Solving ODEs I, §II.6 (dense output) and Shampine & Thompson, "Event location for ordinary
+// differential equations", Comput. Math. Appl. 39 (2000) 43-54.
 #include <memory>
 #include <string>
 
