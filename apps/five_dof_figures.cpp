@@ -43,6 +43,7 @@ FiveDofFigureResult reproduce_five_dof_figure(const std::string& figure,
   const GapStructure structure = make_chain(chain);
   const double period = chain.period();
   const int periods = quick ? 300 : 1000, kept_from = quick ? 200 : 500, steps = 200;
+  const int drawn_periods = 20;  // of trajectory in the phase portrait
   const double eta = period / steps;
 
   PimOptions pim_options;
@@ -83,8 +84,11 @@ FiveDofFigureResult reproduce_five_dof_figure(const std::string& figure,
                                    (pim->velocity() - reference->velocity()).cwiseAbs().maxCoeff());
       result.largest_difference = std::max(result.largest_difference, diff);
       if (k <= static_cast<long>(kept_from) * steps) continue;
-      pim_csv.row({t, pim->position()[4], pim->velocity()[4]});
-      ref_csv.row({t, reference->position()[4], reference->velocity()[4]});
+      // The phase portrait draws the last periods; the Poincaré points cover all kept ones.
+      if (k > static_cast<long>(periods - drawn_periods) * steps) {
+        pim_csv.row({t, pim->position()[4], pim->velocity()[4]});
+        ref_csv.row({t, reference->position()[4], reference->velocity()[4]});
+      }
       if (k % steps == 0) {
         strobe.row({t, pim->position()[4], pim->velocity()[4], reference->position()[4],
                     reference->velocity()[4]});

@@ -7,7 +7,7 @@ set output out
 set datafile separator ','
 set key below horizontal box
 set grid lc rgb '#dddddd'
-set title sprintf("Figure %s: mass 5, %s\n{/*0.85 %d distinct Poincaré points; largest PIM - reference difference %s}", fig, params, points, diff)
+set title sprintf("Figure %s: mass 5, %s\n{/*0.85 trajectory of the last 20 periods; %d distinct Poincaré points; largest PIM - reference difference %s}", fig, params, points, diff)
 set xlabel 'x_5 (nondimensional, k_1x/A)'
 set ylabel "x'_5 (nondimensional)"
 plot sprintf('%s/fig%s_reference.csv', data, fig) using 2:3 every ::1 with lines lw 4 lc rgb '#bbbbbb' title 'dopri5, kink-located, tol 1e-10', \

@@ -1,0 +1,116 @@
+#pragma once
+// Classification of a motion from its Poincaré points and, when available, its largest Lyapunov
+// exponent and the 0-1 test for chaos.
+//
+// Each indicator alone can mislead: a period search misses a period longer than k_max or one
+// still settling; a finite-time Lyapunov exponent of a regular motion is small but not zero; the
+// 0-1 test cannot tell a periodic from a quasi-periodic motion and mistakes rounding noise for
+// diffusion. So the classifier combines them, says which rule decided, and answers "uncertain"
+// when they disagree instead of guessing.
+//
+// Decision rules, in order:
+//
+//  1. unbounded: some coordinate of some point (or of the observable series) is not finite or
+//     exceeds divergence_bound in magnitude. Checked before anything else, so a diverging
+//     sequence is reported before it overflows and a NaN never reaches the other tests.
+//  2. The period search (detect_period with options.period). If a period k is found:
+//       - uncertain if λ1 is known and clearly positive (λ1 - error > lyapunov_margin);
+//       - otherwise period-k, or equilibrium when k = 1 and fixed_point_is_equilibrium.
+//     λ1 within the margin of 0 is accepted: a periodic orbit at a bifurcation, or the neutral
+//     direction along the orbit of an autonomous flow, has λ1 = 0. K is not consulted: a period
+//     that repeats over several cycles is the stronger evidence, and near a fixed point the
+//     series is rounding noise, which the 0-1 test reads as chaos.
+//  3. uncertain if no period could be tested at all (fewer than cycles + 1 points).
+//  4. No period found. λ1 is read as positive (λ1 - error > margin), zero (|λ1| + error <=
+//     margin), negative (λ1 + error < -margin), inconclusive (otherwise) or unknown; K as chaotic
+//     (K > chaotic_K), regular (K < regular_K), in between, or unknown.
+//       - positive and chaotic                  -> chaotic
+//       - zero and regular                      -> quasi-periodic
+//       - positive, K unknown                   -> chaotic        (unless require_all_indicators)
+//       - λ1 unknown, chaotic                   -> chaotic        (unless require_all_indicators)
+//       - zero, K unknown                       -> quasi-periodic (unless require_all_indicators)
+//       - λ1 unknown, regular                   -> quasi-periodic (unless require_all_indicators)
+//       - anything else (disagreement, an inconclusive or in-between value, λ1 < 0 without a
+//         period: a period beyond k_max or a transient not yet over) -> uncertain.
+//
+// Where K comes from: evidence.zero_one_K if given; else the 0-1 test on evidence.observable if
+// that is not empty; else, if zero_one_from_points, the 0-1 test on coordinate
+// observable_component of the points when there are at least zero_one.min_samples of them. It is
+// computed only when rule 4 needs it.
+//
+// λ1 and lyapunov_margin must be in the same units (per iteration of the map, or per unit time).
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "pwl/analysis/period_detection.hpp"
+#include "pwl/analysis/zero_one_test.hpp"
+#include "pwl/types.hpp"
+
+namespace pwl::analysis {
+
+enum class Regime {
+  equilibrium,
+  periodic,  // period-k, k in Classification::period
+  quasi_periodic,
+  chaotic,
+  unbounded,
+  uncertain,
+};
+
+// "equilibrium", "period-3", "quasi-periodic", "chaotic", "unbounded", "uncertain". The period is
+// used only for Regime::periodic.
+std::string regime_name(Regime regime, int period = 0);
+
+// Indicators computed elsewhere, all optional.
+struct MotionEvidence {
+  std::optional<double> lyapunov;        // λ1, finite
+  double lyapunov_error = 0.0;           // its uncertainty (>= 0), e.g. LyapunovResult::error
+  std::optional<double> zero_one_K;      // K from an earlier 0-1 test, in [-1, 1]
+  std::vector<double> observable;        // a scalar series for the 0-1 test, if K is not given
+};
+
+struct ClassifierOptions {
+  PeriodOptions period;
+  ZeroOneOptions zero_one;
+  double lyapunov_margin = 5e-3;    // |λ1| within this counts as zero (> 0)
+  double chaotic_K = 0.8;           // K above this is chaotic
+  double regular_K = 0.2;           // K below this is regular (0 < regular_K <= chaotic_K < 1)
+  double divergence_bound = 1e12;   // |coordinate| beyond this is unbounded (> 0)
+  // A fixed point of the map is an equilibrium (autonomous system sampled in time) or, when
+  // false, a period-1 response (stroboscopic map of a forced system).
+  bool fixed_point_is_equilibrium = true;
+  bool zero_one_from_points = true;
+  Index observable_component = 0;
+  // Demand both λ1 and K before calling a motion chaotic or quasi-periodic.
+  bool require_all_indicators = false;
+
+  bool is_valid(std::string* why) const;
+};
+
+struct Classification {
+  Regime regime = Regime::uncertain;
+  int period = 0;                       // k for periodic; 1 for equilibrium; 0 otherwise
+  PeriodResult period_search;           // not run (default) when unbounded
+  std::optional<double> lyapunov;       // as given
+  double lyapunov_error = 0.0;
+  std::optional<double> zero_one_K;     // given or computed; empty when not available or not needed
+  std::string zero_one_source;          // "given", "observable", "points", or empty
+  std::string reason;                   // the rule that decided, with the numbers
+
+  std::string name() const { return regime_name(regime, period); }
+};
+
+// Throws InputError for invalid options, no points, points of differing dimensions, a non-finite
+// λ1 or K, a negative lyapunov_error, K outside [-1, 1], or an observable_component out of range
+// when K is to be computed from the points. Non-finite points are not an error: they are rule 1.
+Classification classify_motion(const std::vector<Vector>& points,
+                               const MotionEvidence& evidence = {},
+                               const ClassifierOptions& options = {});
+
+// Scalar maps: each point one number.
+Classification classify_motion(const std::vector<double>& values,
+                               const MotionEvidence& evidence = {},
+                               const ClassifierOptions& options = {});
+
+}  // namespace pwl::analysis

@@ -1,1 +1,0 @@
-// Keeps pwl_analysis a real library while it has no other translation unit.
