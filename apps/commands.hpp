@@ -6,6 +6,7 @@
 namespace pwl::app {
 
 void add_simulate_command(CLI::App& app);
+void add_analyze_command(CLI::App& app);
 void add_reproduce_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 

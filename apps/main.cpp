@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("pwl ") + PWL_VERSION);
   app.require_subcommand(1);
   pwl::app::add_simulate_command(app);
+  pwl::app::add_analyze_command(app);
   pwl::app::add_reproduce_command(app);
   pwl::app::add_bench_command(app);
   try {
