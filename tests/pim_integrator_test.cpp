@@ -47,6 +47,19 @@ struct ForcedOscillator {
   }
 };
 
+// The least-squares slope of y against x: a convergence order from log error against log η.
+double fitted_slope(const std::vector<double>& x, const std::vector<double>& y) {
+  const double n = static_cast<double>(x.size());
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    sx += x[i];
+    sy += y[i];
+    sxx += x[i] * x[i];
+    sxy += x[i] * y[i];
+  }
+  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+}
+
 }  // namespace
 
 TEST_CASE("PIM is exact for a forced damped linear oscillator at any step", "[pim]") {
@@ -139,15 +152,7 @@ TEST_CASE("PIM on a gap oscillator converges at order 2 to the closed-form motio
     log_eta.push_back(std::log(period / steps));
     log_error.push_back(std::log(worst));
   }
-  const double n = static_cast<double>(log_eta.size());
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  for (std::size_t i = 0; i < log_eta.size(); ++i) {
-    sx += log_eta[i];
-    sy += log_error[i];
-    sxx += log_eta[i] * log_eta[i];
-    sxy += log_eta[i] * log_error[i];
-  }
-  const double order = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+  const double order = fitted_slope(log_eta, log_error);
   INFO("fitted order " << order);
   CHECK(order > 1.9);
   CHECK(order < 2.1);
@@ -186,15 +191,7 @@ TEST_CASE("PIM on a forced damped gap oscillator converges at order 2 to the ref
     log_eta.push_back(std::log(T / steps));
     log_error.push_back(std::log(worst));
   }
-  const double n = static_cast<double>(log_eta.size());
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  for (std::size_t i = 0; i < log_eta.size(); ++i) {
-    sx += log_eta[i];
-    sy += log_error[i];
-    sxx += log_eta[i] * log_eta[i];
-    sxy += log_eta[i] * log_error[i];
-  }
-  const double order = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+  const double order = fitted_slope(log_eta, log_error);
   INFO("fitted order " << order << ", finest error " << std::exp(log_error.back()));
   CHECK(order > 1.85);
   CHECK(order < 2.15);
