@@ -43,7 +43,7 @@ void analyze(AnalyzeOptions o) {
   }
   const double period = chain.period();
   auto integrator = o.run.integrator(structure, period);
-  const bool exact_tangent = o.run.method == "pim";
+  const bool exact_tangent = integrator->has_tangent_map();
   integrator->advance_to(o.transient * period);
 
   std::filesystem::create_directories(o.out);

@@ -4,9 +4,12 @@
 
 #include <cmath>
 
+#include "pwl/banded_pim_integrator.hpp"
 #include "pwl/errors.hpp"
+#include "pwl/event_driven_solver.hpp"
 #include "pwl/pim_integrator.hpp"
 #include "pwl/reference_integrator.hpp"
+#include "pwl/switching_pim.hpp"
 
 namespace pwl::app {
 
@@ -28,8 +31,11 @@ void add_case_options(CLI::App& c, CaseOptions& o) {
   c.add_option("--steps-per-period", o.steps_per_period, "PIM steps per forcing period")
       ->check(CLI::PositiveNumber);
   c.add_option("--dt", o.dt, "PIM step (must divide the forcing period)");
-  c.add_option("--method", o.method, "Integrator: pim, dopri5 or rkf78")
-      ->check(CLI::IsMember({"pim", "dopri5", "rkf78"}));
+  c.add_option("--method", o.method,
+               "Integrator: pim (dense or banded by size), pim-dense, pim-banded, pim-switching\n"
+               "(higher order, located switches), exact (event-driven), dopri5 or rkf78")
+      ->check(CLI::IsMember(
+          {"pim", "pim-dense", "pim-banded", "pim-switching", "exact", "dopri5", "rkf78"}));
   c.add_option("--tol", o.tolerance, "Relative and absolute tolerance of dopri5/rkf78");
   c.add_flag("--locate-kinks", o.locate_kinks,
              "dopri5/rkf78: end a step exactly at every spring opening or closing");
@@ -74,11 +80,23 @@ double CaseOptions::step(double period) const {
 std::unique_ptr<Integrator> CaseOptions::integrator(const GapStructure& structure,
                                                     double period) const {
   std::unique_ptr<Integrator> result;
-  if (method == "pim") {
+  if (method == "pim" || method == "pim-dense") {
     PimOptions p;
     p.step = step(period);
     p.lcp_solver = lcp_solver;
-    result = make_pim_integrator(structure, p);
+    result = method == "pim" ? make_pim_integrator_auto(structure, p)
+                             : make_pim_integrator(structure, p);
+  } else if (method == "pim-banded") {
+    BandedPimOptions b;
+    b.step = step(period);
+    result = make_banded_pim_integrator(structure, b);
+  } else if (method == "pim-switching") {
+    SwitchingPimOptions s;
+    s.step = step(period);
+    s.lcp_solver = lcp_solver;
+    result = make_switching_pim(structure, s);
+  } else if (method == "exact") {
+    result = make_event_driven_solver(structure);
   } else {
     ReferenceOptions r;
     r.method = parse_runge_kutta_method(method);

@@ -56,6 +56,7 @@ class PimIntegrator final : public Integrator {
     advance(t_end, nullptr, observer);
   }
 
+  bool has_tangent_map() const override { return true; }
   void advance_with_tangent(double t_end, Matrix& tangent, const StepObserver& observer) override {
     advance(t_end, &tangent, observer);
   }

@@ -46,6 +46,8 @@ class Integrator {
   // is that.
   virtual void advance_with_tangent(double t_end, Matrix& tangent,
                                     const StepObserver& observer = nullptr);
+  // Whether advance_with_tangent is implemented (false: it throws).
+  virtual bool has_tangent_map() const { return false; }
 };
 
 }  // namespace pwl
