@@ -28,8 +28,7 @@ struct AnalyzeOptions {
 };
 
 void analyze(AnalyzeOptions o) {
-  const NondimensionalChain chain = o.run.chain();
-  const GapStructure structure = make_chain(chain);
+  const GapStructure structure = o.run.structure();
   const Index n = structure.dofs();
   const int mass = o.mass == 0 ? static_cast<int>(n) : o.mass;
   if (mass < 1 || mass > n) {
@@ -41,7 +40,7 @@ void analyze(AnalyzeOptions o) {
         "--periods = {} with --transient = {} records {} periods; the analysis needs at least 100",
         o.run.periods, o.transient, recorded));
   }
-  const double period = chain.period();
+  const double period = o.run.period();
   auto integrator = o.run.integrator(structure, period);
   const bool exact_tangent = integrator->has_tangent_map();
   integrator->advance_to(o.transient * period);
@@ -107,11 +106,12 @@ void analyze(AnalyzeOptions o) {
   evidence.lyapunov = lyapunov.largest();
   evidence.lyapunov_error = lyapunov.error[0];
   evidence.zero_one_K = zero_one.K;
-  const analysis::Classification c = analysis::classify_motion(points, evidence);
+  analysis::ClassifierOptions classifier;
+  classifier.fixed_point_is_equilibrium = false;  // stroboscopic points: a fixed point is period-1
+  const analysis::Classification c = analysis::classify_motion(points, evidence, classifier);
 
-  fmt::print("case: n = {}, alpha = {}, zeta = {}, gap = {}, theta = {}; {} by {}\n", n,
-             fmt::join(chain.alpha, ","), chain.zeta, fmt::join(chain.gap, ","), chain.theta,
-             recorded, integrator->name());
+  fmt::print("case: n = {}, {}; {} by {}\n", n, o.run.description(), recorded,
+             integrator->name());
   fmt::print("regime: {}\n", c.name());
   fmt::print("  period search: {} (best k = {}, mismatch {:.2e}, {} distinct points)\n",
              c.period_search.period > 0 ? fmt::format("period {}", c.period_search.period)
@@ -130,9 +130,8 @@ void analyze(AnalyzeOptions o) {
   std::string why;
   const std::string definitions = fmt::format(
       "trajectory='{0}/trajectory.csv'; poincare='{0}/poincare.csv'; out='{0}/analysis.png'; "
-      "pxcol={1}; pvcol={2}; mass={3}; label='α = {4}, ζ = {5}, Δ̃ = {6}, θ = {7}: {8}'",
-      o.out, 1 + mass, 1 + n + mass, mass, chain.alpha[0], chain.zeta, chain.gap[0], chain.theta,
-      c.name());
+      "pxcol={1}; pvcol={2}; mass={3}; label='{4}: {5}'",
+      o.out, 1 + mass, 1 + n + mass, mass, o.run.description(), c.name());
   if (run_gnuplot(plots_directory() + "/analysis_panels.gp", definitions, &why)) {
     fmt::print("wrote {0}/poincare.csv, {0}/classification.csv, {0}/analysis.png\n", o.out);
   } else {

@@ -12,6 +12,7 @@
 #include "accuracy_bench.hpp"
 #include "bench_chain.hpp"
 #include "bench_scaling.hpp"
+#include "bench_sweep.hpp"
 #include "commands.hpp"
 
 namespace pwl::app {
@@ -104,6 +105,7 @@ void add_bench_command(CLI::App& app) {
   add_chain(*bench);
   add_scaling(*bench);
   add_accuracy_benches(*bench);
+  add_sweep_bench(*bench);
 }
 
 }  // namespace pwl::app

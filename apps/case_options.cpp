@@ -1,15 +1,18 @@
 #include "case_options.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <cmath>
 
 #include "pwl/banded_pim_integrator.hpp"
+#include "pwl/banded_switching_pim.hpp"
 #include "pwl/errors.hpp"
 #include "pwl/event_driven_solver.hpp"
 #include "pwl/pim_integrator.hpp"
 #include "pwl/reference_integrator.hpp"
 #include "pwl/switching_pim.hpp"
+#include "scene_structure.hpp"
 
 namespace pwl::app {
 
@@ -33,14 +36,44 @@ void add_case_options(CLI::App& c, CaseOptions& o) {
   c.add_option("--dt", o.dt, "PIM step (must divide the forcing period)");
   c.add_option("--method", o.method,
                "Integrator: pim (dense or banded by size), pim-dense, pim-banded, pim-switching\n"
-               "(higher order, located switches), exact (event-driven), dopri5 or rkf78")
-      ->check(CLI::IsMember(
-          {"pim", "pim-dense", "pim-banded", "pim-switching", "exact", "dopri5", "rkf78"}));
+               "(higher order, located switches; dense or banded by size), pim-switching-banded,\n"
+               "exact (event-driven), dopri5 or rkf78")
+      ->check(CLI::IsMember({"pim", "pim-dense", "pim-banded", "pim-switching",
+                             "pim-switching-banded", "exact", "dopri5", "rkf78"}));
   c.add_option("--tol", o.tolerance, "Relative and absolute tolerance of dopri5/rkf78");
   c.add_flag("--locate-kinks", o.locate_kinks,
              "dopri5/rkf78: end a step exactly at every spring opening or closing");
+  c.add_option("--structure-scene", o.structure_scene,
+               "Integrate the explicit structure (M, C, K, gap springs, loads) of this scene\n"
+               "file's [structure] table instead of the chain")
+      ->check(CLI::ExistingFile);
   c.add_option("--lcp", o.lcp_solver, "PIM's LCP solver: block-pivoting or lemke")
       ->check(CLI::IsMember({"block-pivoting", "lemke"}));
+}
+
+GapStructure CaseOptions::structure() const {
+  if (!explicit_structure()) return make_chain(chain());
+  const bool chain_flags = !figure.empty() || !alpha.empty() || !std::isnan(zeta) ||
+                           !std::isnan(gap) || !gaps.empty() || !std::isnan(theta) ||
+                           !loads.empty() || masses != 5;
+  if (chain_flags) {
+    throw InputError(fmt::format(
+        "--structure-scene {}: the chain's flags (--figure, --n, --alpha, --zeta, --gap, --gaps, "
+        "--theta, --loads) do not apply to an explicit structure",
+        structure_scene));
+  }
+  return read_scene_structure(structure_scene);
+}
+
+double CaseOptions::period() const {
+  return explicit_structure() ? structure().common_period() : chain().period();
+}
+
+std::string CaseOptions::description() const {
+  if (explicit_structure()) return fmt::format("the structure of {}", structure_scene);
+  const NondimensionalChain c = chain();
+  return fmt::format("α = {}, ζ = {}, Δ̃ = {}, θ = {}", fmt::join(c.alpha, ","), c.zeta,
+                     fmt::join(c.gap, ","), c.theta);
 }
 
 NondimensionalChain CaseOptions::chain() const {
@@ -90,11 +123,18 @@ std::unique_ptr<Integrator> CaseOptions::integrator(const GapStructure& structur
     BandedPimOptions b;
     b.step = step(period);
     result = make_banded_pim_integrator(structure, b);
-  } else if (method == "pim-switching") {
+  } else if (method == "pim-switching" || method == "pim-switching-banded") {
     SwitchingPimOptions s;
     s.step = step(period);
     s.lcp_solver = lcp_solver;
-    result = make_switching_pim(structure, s);
+    if (method == "pim-switching-banded" ||
+        (banded_layout(structure).banded && structure.dofs() > 50)) {
+      BandedSwitchingPimOptions b;
+      b.pim = s;
+      result = make_banded_switching_pim(structure, b);
+    } else {
+      result = make_switching_pim(structure, s);
+    }
   } else if (method == "exact") {
     result = make_event_driven_solver(structure);
   } else {

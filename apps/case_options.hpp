@@ -30,9 +30,19 @@ struct CaseOptions {
   double tolerance = 1e-10;
   bool locate_kinks = false;
   std::string lcp_solver = "block-pivoting";
+  // An explicit structure from a scene file's [structure] table (scene_structure.hpp) instead of
+  // the chain; the chain's flags do not apply then.
+  std::string structure_scene;
 
   // The chain these flags describe (the preset, then each given flag).
   NondimensionalChain chain() const;
+  bool explicit_structure() const { return !structure_scene.empty(); }
+  // The structure: the chain's, or the scene file's explicit one.
+  GapStructure structure() const;
+  // The forcing period: the chain's, or the common period of the explicit structure's loads.
+  double period() const;
+  // A short description for titles and messages.
+  std::string description() const;
   // The step the PIM uses: period / steps_per_period, or dt when it divides the period.
   double step(double period) const;
   // The integrator the flags name, with its state at rest at t = 0.

@@ -9,5 +9,7 @@ void add_simulate_command(CLI::App& app);
 void add_analyze_command(CLI::App& app);
 void add_reproduce_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
+void add_sweep_command(CLI::App& app);
+void add_map_command(CLI::App& app);
 
 }  // namespace pwl::app

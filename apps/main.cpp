@@ -4,9 +4,12 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
+#include <string>
+#include <vector>
 
 #include "commands.hpp"
 #include "pwl/errors.hpp"
+#include "scene_command_line.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -18,9 +21,22 @@ int main(int argc, char** argv) {
   pwl::app::add_analyze_command(app);
   pwl::app::add_reproduce_command(app);
   pwl::app::add_bench_command(app);
+  pwl::app::add_sweep_command(app);
+  pwl::app::add_map_command(app);
+  pwl::app::add_run_command(app);
+  for (const char* job : {"simulate", "analyze", "sweep", "map"}) {
+    pwl::app::add_scene_options(*app.get_subcommand(job));
+  }
+  pwl::app::ExpandedCommandLine line;
   try {
-    app.parse(argc, argv);
+    line = pwl::app::expand_scenes(std::vector<std::string>(argv + 1, argv + argc), app);
+    std::vector<std::string> reversed(line.args.rbegin(), line.args.rend());  // CLI11's order
+    app.parse(reversed);
   } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() != 0 && !line.settings.empty()) {
+      fmt::print(stderr, "pwl: bad input: {}\n", pwl::app::locate_in_scene(e.what(), line));
+      return 2;
+    }
     const int code = app.exit(e);
     return code == 0 ? 0 : 2;
   } catch (const pwl::InputError& e) {

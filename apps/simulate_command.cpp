@@ -22,8 +22,7 @@ struct SimulateOptions {
 };
 
 void simulate(const SimulateOptions& o) {
-  const NondimensionalChain chain = o.run.chain();
-  const GapStructure structure = make_chain(chain);
+  const GapStructure structure = o.run.structure();
   const Index n = structure.dofs();
   for (int r : o.record) {
     if (r < 1 || r > n) {
@@ -34,7 +33,7 @@ void simulate(const SimulateOptions& o) {
     throw InputError(fmt::format("--skip-periods = {} leaves nothing of --periods = {}",
                                  o.run.skip_periods, o.run.periods));
   }
-  const double period = chain.period();
+  const double period = o.run.period();
   auto integrator = o.run.integrator(structure, period);
   std::filesystem::create_directories(o.out);
 
@@ -75,9 +74,9 @@ void simulate(const SimulateOptions& o) {
     const std::string definitions = fmt::format(
         "trajectory='{0}/trajectory.csv'; poincare='{0}/poincare.csv'; out='{0}/phase.png'; "
         "xcol={1}; vcol={2}; pxcol={3}; pvcol={4}; mass={5}; "
-        "label='{6}, θ = {7}, {8} periods after {9}'",
+        "label='{6}, {7}, {8} periods after {9}'",
         o.out, 2, 2 + o.record.size(), 1 + mass, 1 + n + mass, mass, integrator->name(),
-        chain.theta, o.run.periods - o.run.skip_periods, o.run.skip_periods);
+        o.run.description(), o.run.periods - o.run.skip_periods, o.run.skip_periods);
     if (run_gnuplot(plots_directory() + "/phase_portrait.gp", definitions, &why)) {
       if (!o.quiet) fmt::print("wrote {}/phase.png\n", o.out);
     } else {

@@ -75,6 +75,25 @@ class PimIntegrator final : public Integrator {
           t_end, propagator_.time(), span, eta));
     }
     const long count = static_cast<long>(whole);
+    if constexpr (Dofs != Eigen::Dynamic && Dofs == Springs) {
+      // One tangent vector on fixed-size storage (λ1 alone): the single-vector map.
+      if (tangent != nullptr && tangent->cols() == 1 && tangent->rows() == 2 * Dofs) {
+        typename PrecisePropagator<Dofs, Springs>::StateVector y = *tangent;
+        for (long k = 0; k < count; ++k) {
+          propagator_.step();
+          propagator_.apply_step_tangent_vector(y);
+          stats_.lcp_pivots += propagator_.last_lcp_pivots();
+          if (observer) {
+            sync();
+            observer(propagator_.time(), position_, velocity_);
+          }
+        }
+        *tangent = y;
+        stats_.steps += count;
+        sync();
+        return;
+      }
+    }
     for (long k = 0; k < count; ++k) {
       propagator_.step();
       if (tangent != nullptr) propagator_.apply_step_tangent(*tangent);

@@ -6,6 +6,8 @@
 // runs on fixed-size Eigen types (no heap, unrolled products); PrecisePropagator<> is the
 // run-time-sized version. Time is kept as t_origin + k η with an integer step count, so that a
 // million steps land on kT exactly rather than accumulating rounding.
+#include <algorithm>
+#include <bit>
 #include <cmath>
 #include <memory>
 #include <vector>
@@ -52,7 +54,8 @@ class PrecisePropagator {
     gap_rows_ = ops.stiffnesses.asDiagonal() * ops.directions.transpose();  // K2 W^T
     gap_offset_ = ops.stiffnesses.cwiseProduct(ops.gaps);                 // K2 Δ
     for (const HarmonicResponse& h : ops.harmonics) {
-      harmonics_.push_back({h.omega, h.sin_response, h.cos_response});
+      harmonics_.push_back({h.omega, std::cos(h.omega * eta_), std::sin(h.omega * eta_), 0.0, 1.0,
+                            h.sin_response, h.cos_response});
     }
     std::string why;
     if (m > 0 && !is_p_matrix(ops.lcp_matrix, &why)) {
@@ -63,6 +66,13 @@ class PrecisePropagator {
     }
     solver_->set_matrix(ops.lcp_matrix);
     lcp_matrix_ = ops.lcp_matrix;
+    if constexpr (kInlineLcp) {
+      inline_lcp_ = solver_->name() == "block-pivoting";
+      const double mmax = m > 0 ? lcp_matrix_.cwiseAbs().maxCoeff() : 0.0;
+      lcp_scale_ = mmax > 0.0 ? mmax : 1.0;
+      transforms_.resize(std::size_t{1} << Springs);
+      transform_ready_.assign(std::size_t{1} << Springs, 0);
+    }
     state_ = StateVector::Zero(2 * n_);
     bar_ = state_;
     forces_ = ForceVector::Zero(m);
@@ -86,24 +96,49 @@ class PrecisePropagator {
     state_.tail(n_) = v;
     // k max(0, W^T x - Δ) = max(0, K2 W^T x - K2 Δ)
     forces_ = (gap_rows_ * state_.head(n_) - gap_offset_).cwiseMax(0.0);
+    forces_zero_ = !(forces_.array() > 0.0).any();
+    anchor_harmonics();
   }
 
   // One step of size η.
+  //
+  // The hot loop of every long run, so it avoids work that does not change the result:
+  //  - sin ωt_k and cos ωt_k are advanced by the fixed rotation through ωη (one 2x2 product)
+  //    instead of calling sin and cos, and re-anchored to the exact values every
+  //    kReanchorSteps steps, so the rotation's rounding never accumulates beyond a few ulps;
+  //  - with every spring open (P_k = 0) the product Ψ P_k is skipped, and when the LCP's
+  //    right-hand side q is non-negative the answer is P_{k+1} = 0 (the solver's own first
+  //    test) without calling it, and Φ P_{k+1} is skipped as well.
   void step() {
-    const double t = time();
-    bar_.noalias() = transition_ * state_;
-    bar_.noalias() += force_now_ * forces_;
-    for (const Harmonic& h : harmonics_) {
-      bar_ += std::sin(h.omega * t) * h.sin_response + std::cos(h.omega * t) * h.cos_response;
+    // lazyProduct: coefficient-wise, unrolled for fixed sizes (Eigen would otherwise call its
+    // general matrix-vector kernel for more than 8 rows, which costs more than the product).
+    bar_.noalias() = transition_.lazyProduct(state_);
+    if (!forces_zero_) bar_.noalias() += force_now_.lazyProduct(forces_);
+    for (Harmonic& h : harmonics_) {
+      bar_ += h.sin_now * h.sin_response + h.cos_now * h.cos_response;
     }
     // q = K2 (Δ - W^T x̄); warm start from the current forces.
-    q_.noalias() = gap_offset_ - gap_rows_ * bar_.head(n_);
-    next_forces_ = forces_;
-    last_pivots_ = solver_->solve(q_, next_forces_, slack_).pivots;
-    state_ = bar_;
-    state_.noalias() += force_next_ * next_forces_;
-    forces_.swap(next_forces_);
+    q_.noalias() = gap_offset_ - gap_rows_.lazyProduct(bar_.head(n_));
+    if (q_.size() == 0 || q_.minCoeff() >= 0.0) {
+      next_forces_.setZero();
+      last_pivots_ = 0;
+      state_ = bar_;
+      forces_.swap(next_forces_);
+      forces_zero_ = true;
+    } else {
+      next_forces_ = forces_;
+      if constexpr (kInlineLcp) {
+        last_pivots_ = inline_lcp_ ? solve_inline() : solver_->solve(q_, next_forces_, slack_).pivots;
+      } else {
+        last_pivots_ = solver_->solve(q_, next_forces_, slack_).pivots;
+      }
+      state_ = bar_;
+      state_.noalias() += force_next_.lazyProduct(next_forces_);
+      forces_.swap(next_forces_);
+      forces_zero_ = !(forces_.array() > 0.0).any();
+    }
     ++steps_;
+    advance_harmonics();
     const double largest = state_.cwiseAbs().maxCoeff();
     if (!(largest <= bound_)) {
       throw DivergenceError(fmt::format(
@@ -153,6 +188,32 @@ class PrecisePropagator {
     tangent = std::move(next);
   }
 
+  // The same map applied to one tangent vector y (2n), for fixed sizes (kInlineLcp): a Lyapunov
+  // exponent λ1 by one vector costs about one more step instead of 2n matrix columns. The
+  // matrix Φ_A M_AA⁻¹ R_A is computed once per active set A and kept.
+  void apply_step_tangent_vector(StateVector& y) {
+    static_assert(kInlineLcp, "apply_step_tangent_vector needs fixed sizes");
+    ForceVector reaction = gap_rows_.lazyProduct(y.template head<kDofs>());
+    bool any = false;
+    for (Index j = 0; j < reaction.size(); ++j) {
+      if (!(next_forces_[j] > 0.0)) {
+        reaction[j] = 0.0;
+      } else {
+        any = true;
+      }
+    }
+    StateVector next = transition_.lazyProduct(y);
+    if (any) next.noalias() += force_now_.lazyProduct(reaction);
+    unsigned mask = 0;
+    for (Index j = 0; j < forces_.size(); ++j)
+      if (forces_[j] > 0.0) mask |= 1u << j;
+    if (mask != 0) {
+      const StateVector correction = tangent_correction(mask).lazyProduct(next.template head<kDofs>());
+      next += correction;
+    }
+    y = next;
+  }
+
   double time() const { return origin_ + static_cast<double>(steps_) * eta_; }
   double step_size() const { return eta_; }
   long step_count() const { return steps_; }
@@ -164,11 +225,171 @@ class PrecisePropagator {
   int last_lcp_pivots() const { return last_pivots_; }
 
  private:
+  // A fixed number of springs (up to 12) with the block-pivoting solver: the LCP is solved here,
+  // by the same method as make_block_pivoting_solver() (Júdice & Pires 1994, block principal
+  // pivoting warm-started from the previous active set, with Murty's single pivoting as the
+  // fall-back that terminates on P-matrices), with the same tolerances, on fixed-size storage and
+  // without a virtual call or the solver's input checks, whose inputs are known valid here. The
+  // transform T_A with x = T_A q (z_A = -M_AA⁻¹ q_A, w_F = q_F - M_FA M_AA⁻¹ q_A) is computed once
+  // per active set A met and kept.
+  static constexpr bool kInlineLcp = Springs != Eigen::Dynamic && Springs <= 12;
+  static constexpr int kInlineSprings = kInlineLcp ? Springs : 1;
+  static constexpr double kLcpFeasTol = 1e-11;  // as in lcp_solver.cpp: relative to |q|_inf
+  static constexpr int kLcpBlockTries = 3;
+  using LcpTransform = Eigen::Matrix<double, kInlineSprings, kInlineSprings, Eigen::RowMajor>;
+
+  const LcpTransform& lcp_transform(unsigned mask) {
+    LcpTransform& t = transforms_[mask];
+    if (transform_ready_[mask]) return t;
+    int ia[kInlineSprings];
+    int k = 0;
+    for (int i = 0; i < kInlineSprings; ++i)
+      if (mask >> i & 1u) ia[k++] = i;
+    Matrix block(k, k);
+    for (int a = 0; a < k; ++a)
+      for (int b = 0; b < k; ++b) block(a, b) = lcp_matrix_(ia[a], ia[b]);
+    Matrix inverse = Matrix::Identity(k, k);
+    if (k > 0) {
+      const Eigen::FullPivLU<Matrix> lu(block);
+      if (!lu.isInvertible()) {
+        throw LcpError(fmt::format("block pivoting: the principal block of the step's LCP matrix "
+                                   "for active-set mask {} is singular (not a P-matrix?)",
+                                   mask));
+      }
+      inverse = lu.inverse();
+    }
+    t.setZero();
+    for (int a = 0; a < k; ++a)
+      for (int b = 0; b < k; ++b) t(ia[a], ia[b]) = -inverse(a, b);
+    for (int i = 0; i < kInlineSprings; ++i) {
+      if (mask >> i & 1u) continue;
+      t(i, i) = 1.0;
+      for (int b = 0; b < k; ++b) {
+        double s = 0.0;
+        for (int a = 0; a < k; ++a) s += lcp_matrix_(i, ia[a]) * inverse(a, b);
+        t(i, ia[b]) = -s;
+      }
+    }
+    transform_ready_[mask] = 1;
+    return t;
+  }
+
+  static constexpr int kDofs = kInlineLcp ? Dofs : 1;
+  using TangentCorrection = Eigen::Matrix<double, 2 * kDofs, kDofs>;
+
+  // Φ_A M_AA⁻¹ R_A for the active set `mask` (R = K2 W^T acting on the displacements).
+  const TangentCorrection& tangent_correction(unsigned mask) {
+    if (corrections_.empty()) {
+      corrections_.resize(std::size_t{1} << kInlineSprings);
+      correction_ready_.assign(std::size_t{1} << kInlineSprings, 0);
+    }
+    TangentCorrection& c = corrections_[mask];
+    if (correction_ready_[mask]) return c;
+    std::vector<Index> active;
+    for (Index j = 0; j < kInlineSprings; ++j)
+      if (mask >> j & 1u) active.push_back(j);
+    const Index a = static_cast<Index>(active.size());
+    Matrix block(a, a), rows(a, n_), columns(2 * n_, a);
+    for (Index r = 0; r < a; ++r) {
+      for (Index k = 0; k < a; ++k) block(r, k) = lcp_matrix_(active[r], active[k]);
+      rows.row(r) = gap_rows_.row(active[r]);
+      columns.col(r) = force_next_.col(active[r]);
+    }
+    c = columns * block.partialPivLu().solve(rows);
+    correction_ready_[mask] = 1;
+    return c;
+  }
+
+  // Solves the step's LCP for q_ into next_forces_ (holding the warm start) and slack_; returns
+  // the pivots.
+  int solve_inline() {
+    constexpr int n = kInlineSprings;
+    const double tol_w = kLcpFeasTol * q_.cwiseAbs().maxCoeff();
+    const double tol_z = tol_w / lcp_scale_;
+    if (q_.minCoeff() >= -tol_w) {  // z = 0 solves it
+      next_forces_.setZero();
+      slack_ = q_.cwiseMax(0.0);
+      return 0;
+    }
+    unsigned mask = 0;
+    for (int i = 0; i < n; ++i)
+      if (next_forces_[i] > 0.0) mask |= 1u << i;
+    Eigen::Matrix<double, n, 1> x;
+    int pivots = 0;
+    int best_count = n + 1;
+    int tries = kLcpBlockTries;
+    const long max_iter = 50L * (n + 1) * (n + 1) + (n + 1) * ((1L << n) + kLcpBlockTries + 2);
+    for (long iter = 0;; ++iter) {
+      if (iter >= max_iter) {
+        throw LcpError(fmt::format(
+            "block pivoting: no solution after {} iterations (n = {}), the iteration limit "
+            "(M is not a P-matrix?)",
+            iter, n));
+      }
+      x.noalias() = lcp_transform(mask).lazyProduct(q_);
+      unsigned infeasible = 0;
+      for (int i = 0; i < n; ++i) {
+        const double tol = (mask >> i & 1u) ? tol_z : tol_w;
+        if (x[i] < -tol) infeasible |= 1u << i;
+      }
+      if (infeasible == 0) break;
+      const int count = std::popcount(infeasible);
+      if (count < best_count || tries > 0) {
+        if (count < best_count) {
+          best_count = count;
+          tries = kLcpBlockTries;
+        } else {
+          --tries;
+        }
+        mask ^= infeasible;
+        pivots += count;
+      } else {  // Murty: switch only the largest infeasible index
+        mask ^= 1u << (31 - std::countl_zero(infeasible));
+        pivots += 1;
+      }
+    }
+    for (int i = 0; i < n; ++i) {
+      const double v = std::max(x[i], 0.0);
+      const bool basic_z = mask >> i & 1u;
+      next_forces_[i] = basic_z ? v : 0.0;
+      slack_[i] = basic_z ? 0.0 : v;
+    }
+    return pivots;
+  }
+
+  // Harmonic loads are re-anchored to exact sin and cos after this many rotations.
+  static constexpr long kReanchorSteps = 256;
+
   struct Harmonic {
     double omega;
+    double cos_step;  // cos ωη
+    double sin_step;  // sin ωη
+    double sin_now;   // sin ω t for the current time t
+    double cos_now;   // cos ω t
     StateVector sin_response;
     StateVector cos_response;
   };
+
+  void anchor_harmonics() {
+    const double t = time();
+    for (Harmonic& h : harmonics_) {
+      h.sin_now = std::sin(h.omega * t);
+      h.cos_now = std::cos(h.omega * t);
+    }
+  }
+
+  // sin ω(t + η) = sin ωt cos ωη + cos ωt sin ωη, cos ω(t + η) = cos ωt cos ωη - sin ωt sin ωη.
+  void advance_harmonics() {
+    if (steps_ % kReanchorSteps == 0) {
+      anchor_harmonics();
+      return;
+    }
+    for (Harmonic& h : harmonics_) {
+      const double s = h.sin_now, c = h.cos_now;
+      h.sin_now = s * h.cos_step + c * h.sin_step;
+      h.cos_now = c * h.cos_step - s * h.sin_step;
+    }
+  }
 
   Index n_;
   double eta_;
@@ -184,6 +405,13 @@ class PrecisePropagator {
   double origin_ = 0.0;
   long steps_ = 0;
   int last_pivots_ = 0;
+  bool forces_zero_ = true;  // every entry of forces_ is 0
+  bool inline_lcp_ = false;  // kInlineLcp and the solver is block pivoting
+  double lcp_scale_ = 1.0;   // max |M_ij| of the LCP matrix
+  std::vector<LcpTransform> transforms_;
+  std::vector<unsigned char> transform_ready_;
+  std::vector<TangentCorrection> corrections_;
+  std::vector<unsigned char> correction_ready_;
   StateVector state_, bar_;
   ForceVector forces_, next_forces_, q_, slack_;
 };

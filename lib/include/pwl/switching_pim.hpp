@@ -61,12 +61,13 @@
 // The banded stepper. The design carries over: the smooth step is products with constant
 // operators (T, Ξ̂_r G: banded for a chain, SPEC §4) and with H, W, K2 (sparse), plus the one
 // constant LCP matrix I - K2 W^T Φ_x (banded too). This implementation is dense (the fixed-size
-// path for up to 6 springs, dynamic sizes otherwise); a banded version needs (1) the moments
-// Ξ̂_r [0; I], r = 0..d+2, of every substructure (polynomial_force_integrals on the
-// substructure's H, next to the rising and falling loads, which are Ξ̂_1 and Ξ̂_0 - Ξ̂_1) and
-// their banded assembly, (2) sparse products in the Taylor recursion and the pieces (O(n) per
-// term instead of O(n²)), and, to stay cheap on long chains where a spring switches in nearly
-// every step, (3) pieces restricted to the band around the switching spring.
+// path for up to 6 springs, dynamic sizes otherwise); the banded one is
+// make_banded_switching_pim (banded_switching_pim.hpp): (1) the moments Ξ̂_r [0; I],
+// r = 0..d+2, of every substructure (polynomial_force_integrals on the substructure's H, next to
+// the rising and falling loads, which are Ξ̂_1 and Ξ̂_0 - Ξ̂_1) in a banded assembly, and (2)
+// sparse products in the Taylor recursion and the pieces (O(n) per term instead of O(n²)). Not
+// done yet: to stay cheap on long chains where a spring switches in nearly every step, (3)
+// pieces restricted to the band around the switching spring.
 //
 // References: W. X. Zhong and F. W. Williams, Proc. IMechE C 208 (1994) 427-430 (precise
 // integration); C. F. Van Loan, IEEE TAC 23 (1978) 395-404 (integrals of the exponential);

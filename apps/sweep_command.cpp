@@ -1,0 +1,98 @@
+// pwl sweep: a one-parameter sweep of the nondimensional chain, the data and the figure of a
+// bifurcation diagram (see analysis/include/pwl/analysis/parameter_sweep.hpp).
+#include <fmt/format.h>
+
+#include <memory>
+
+#include "commands.hpp"
+#include "gnuplot.hpp"
+#include "pwl/analysis/parameter_sweep.hpp"
+#include "pwl/errors.hpp"
+#include "study_runner.hpp"
+
+namespace pwl::app {
+namespace {
+
+struct SweepFlags {
+  ChainFlags chain;
+  PointFlags point;
+  RunFlags run;
+  std::string parameter = "theta";
+  std::string range = "0.5:3";
+  int points = 100;
+  std::string mode = "independent";
+  std::string directions = "both";
+};
+
+analysis::SweepOptions sweep_options(const SweepFlags& f) {
+  analysis::SweepOptions o;
+  o.chain = f.chain.chain();
+  o.parameter = analysis::parse_sweep_parameter(f.parameter);
+  parse_range("--range", f.range, &o.from, &o.to);
+  o.points = f.points;
+  o.mode = f.mode == "continuation" ? analysis::SweepMode::continuation
+                                    : analysis::SweepMode::independent;
+  o.upward = f.directions != "down";
+  o.downward = f.directions != "up";
+  o.point = f.point.settings(o.chain.masses);
+  std::string why;
+  if (!o.is_valid(&why)) throw InputError(why);
+  return o;
+}
+
+void sweep(const SweepFlags& f) {
+  const analysis::SweepOptions o = sweep_options(f);
+  Study study;
+  study.description = o.describe();
+  study.tasks = o.tasks();
+  study.chain_of = [o](long id) { return o.chain_of(id); };
+  study.initial_state = o.start_state();
+  study.settings = o.point;
+  study.finish = [&](const std::map<long, analysis::PointResult>& records) {
+    analysis::write_sweep_files(o, records, f.run.out);
+    fmt::print("wrote {0}/poincare.csv and {0}/classification.csv ({1} points)\n", f.run.out,
+               records.size());
+    if (f.run.no_plot) return;
+    std::string why;
+    const std::string definitions = fmt::format(
+        "poincare='{0}/poincare.csv'; classes='{0}/classification.csv'; out='{0}/bifurcation.png'; "
+        "column=5; xname='{1}'; yname='{2}'",
+        f.run.out, analysis::parameter_name(o.parameter),
+        o.point.components.empty() ? std::string("x")
+                                   : analysis::component_name(o.point.components[0],
+                                                              o.chain.masses));
+    if (run_gnuplot(plots_directory() + "/bifurcation.gp", definitions, &why)) {
+      fmt::print("wrote {}/bifurcation.png\n", f.run.out);
+    } else {
+      fmt::print(stderr, "pwl sweep: no figure: {}\n", why);
+    }
+  };
+  run_study(study, f.run);
+}
+
+}  // namespace
+
+void add_sweep_command(CLI::App& app) {
+  auto flags = std::make_shared<SweepFlags>();
+  CLI::App* c = app.add_subcommand(
+      "sweep",
+      "Bifurcation diagram: Poincaré points and regimes over one parameter\n"
+      "Example: pwl sweep --figure 5 --parameter theta --range 0.5:3 --points 200 \\\n"
+      "           --mode continuation --out theta_sweep");
+  add_chain_flags(*c, flags->chain);
+  c->add_option("--parameter", flags->parameter,
+                "Parameter swept: theta, alpha, zeta, gap (Δ̃) or amplitude (scales Q)");
+  c->add_option("--range", flags->range, "FROM:TO, from < to");
+  c->add_option("--points", flags->points, "Number of parameter values N");
+  c->add_option("--mode", flags->mode,
+                "independent (every point from rest) or continuation (from the previous point's "
+                "final state, upward and downward)")
+      ->check(CLI::IsMember({"independent", "continuation"}));
+  c->add_option("--directions", flags->directions, "Continuation branches: both, up or down")
+      ->check(CLI::IsMember({"both", "up", "down"}));
+  add_point_flags(*c, flags->point, true);
+  add_run_flags(*c, flags->run);
+  c->callback([flags] { sweep(*flags); });
+}
+
+}  // namespace pwl::app
