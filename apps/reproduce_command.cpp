@@ -13,6 +13,7 @@
 #include "commands.hpp"
 #include "five_dof_figures.hpp"
 #include "gnuplot.hpp"
+#include "paper_scenes.hpp"
 #include "pwl/errors.hpp"
 
 namespace pwl::app {
@@ -33,8 +34,8 @@ bool wanted(const ReproduceOptions& o, const std::string& figure) {
 
 void reproduce(const ReproduceOptions& o) {
   for (const std::string& f : o.only) {
-    if (f != "4a" && f != "4b" && f != "7-9") {
-      throw InputError(fmt::format("--only: unknown figure '{}' (expected 4a, 4b or 7-9)", f));
+    if (f != "4a" && f != "4b" && f != "5-6" && f != "7-9") {
+      throw InputError(fmt::format("--only: unknown figure '{}' (expected 4a, 4b, 5-6 or 7-9)", f));
     }
   }
   const std::string plots = o.plots.empty() ? plots_directory() : o.plots;
@@ -57,6 +58,19 @@ void reproduce(const ReproduceOptions& o) {
                                          r.largest_poincare_difference, r.attractor_size);
     fmt::print("{}  (PIM {:.2f} s, reference {:.2f} s)\n", line, r.pim_seconds, r.reference_seconds);
     report += line;
+  }
+  if (wanted(o, "5-6")) {
+    const std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
+    report +=
+        "\n## Figures 5 and 6: the shipped scenes apps/scenes/paper_fig5.toml and paper_fig6.toml\n\n"
+        "| figure | paper says | pwl finds | λ1 (per forcing period) | 0-1 test | matches |\n"
+        "|---|---|---|---|---|---|\n";
+    for (const SceneRegime& r : run_paper_scenes(self, plots, o.quick)) {
+      // λ1's error bar is a statistical one, so only the regime goes in the report.
+      report += fmt::format("| {} | {} | {} | {} | {} | {} |\n", r.figure, r.paper_regime,
+                            r.regime, r.lambda1.substr(0, r.lambda1.find(" ±")),
+                            r.zero_one, r.regime == r.paper_regime ? "yes" : "**no**");
+    }
   }
   if (wanted(o, "7-9")) {
     const ChainFigureSummary c = reproduce_chain_figures(plots, o.quick);
@@ -91,7 +105,7 @@ void add_reproduce_command(CLI::App& app) {
                          "         pwl reproduce --quick    (a smoke run in seconds)");
   c->add_option("--plots", options->plots, "Folder for figures and data (default: plots/)");
   c->add_flag("--quick", options->quick, "Short runs, for smoke tests");
-  c->add_option("--only", options->only, "Only these figures (4a, 4b, 7-9)")->delimiter(',');
+  c->add_option("--only", options->only, "Only these figures (4a, 4b, 5-6, 7-9)")->delimiter(',');
   c->callback([options] { reproduce(*options); });
 }
 

@@ -10,6 +10,7 @@
 #include <memory>
 #include <sstream>
 
+#include "case_options.hpp"
 #include "distributed.hpp"
 #include "progress_bar.hpp"
 #include "pwl/analysis/parameter_sweep.hpp"
@@ -21,20 +22,16 @@ namespace pwl::app {
 namespace fs = std::filesystem;
 
 NondimensionalChain ChainFlags::chain() const {
-  NondimensionalChain c;
-  if (!figure.empty()) c = paper_five_dof_case(figure);
+  // The same chain flags as simulate and analyze, built the same way.
+  CaseOptions c;
+  c.figure = figure;
   c.masses = masses;
-  if (!alpha.empty()) c.alpha = alpha;
-  if (!std::isnan(zeta)) c.zeta = zeta;
-  if (!std::isnan(gap)) c.gap = {gap};
-  if (!std::isnan(theta)) c.theta = theta;
-  if (!loads.empty()) {
-    c.amplitude = loads;
-  } else if (masses != 5) {
-    c.amplitude.clear();
-    for (int i = 0; i < masses; ++i) c.amplitude.push_back(i % 2 == 0 ? 1.0 : -1.0);
-  }
-  return c;
+  c.alpha = alpha;
+  c.zeta = zeta;
+  c.gap = gap;
+  c.theta = theta;
+  c.loads = loads;
+  return c.chain();
 }
 
 void add_chain_flags(CLI::App& c, ChainFlags& f) {
