@@ -1,9 +1,9 @@
 #include "chain_figures.hpp"
 
+#include <fmt/format.h>
+
 #include <cstdio>
 #include <filesystem>
-
-#include <fmt/format.h>
 
 #include "bench_chain.hpp"
 #include "csv_writer.hpp"
@@ -41,13 +41,15 @@ ChainFigureSummary reproduce_chain_figures(const std::string& plots_dir, bool qu
   {  // closed before gnuplot reads them
     CsvWriter csv(phase, {"t", "x1", "v1"});
     for (std::size_t i = 0; i < pim->record.t.size(); ++i) {
-      if (pim->record.t[i] >= 100.0) csv.row({pim->record.t[i], pim->record.x[i], pim->record.v[i]});
+      if (pim->record.t[i] >= 100.0)
+        csv.row({pim->record.t[i], pim->record.x[i], pim->record.v[i]});
     }
     for (auto [path, m] : {std::pair{pim_errors, pim}, std::pair{rk_errors, rk}}) {
       CsvWriter e(path, {"t", "error_x1", "error_v1"});
       for (std::size_t i = 0; i < m->record.t.size(); ++i) {
         const double t = m->record.t[i];
-        e.row({t, m->record.x[i] - r.reference.position(t), m->record.v[i] - r.reference.velocity(t)});
+        e.row({t, m->record.x[i] - r.reference.position(t),
+               m->record.v[i] - r.reference.velocity(t)});
       }
     }
   }
@@ -65,14 +67,15 @@ ChainFigureSummary reproduce_chain_figures(const std::string& plots_dir, bool qu
                         &why);
   for (auto [fig, path, m, label] :
        {std::tuple{8, pim_errors, pim, std::string("banded PIM, η = 0.02 s")},
-        std::tuple{9, rk_errors, rk, std::string("dopri5, rtol = atol = 1e-5 (plain, like ode45)")}}) {
+        std::tuple{9, rk_errors, rk,
+                   std::string("dopri5, rtol = atol = 1e-5 (plain, like ode45)")}}) {
     if (!ok) break;
-    ok = run_gnuplot(dir + "/fig8_9_errors.gp",
-                     fmt::format("data='{}'; out='{}/fig{}.png'; fig={}; method='{}'; params='{}'; "
-                                 "reference='{}'; ex='{:.1e}'; ev='{:.1e}'",
-                                 path, plots_dir, fig, fig, label, chain, reference, m->error_x,
-                                 m->error_v),
-                     &why);
+    ok = run_gnuplot(
+        dir + "/fig8_9_errors.gp",
+        fmt::format("data='{}'; out='{}/fig{}.png'; fig={}; method='{}'; params='{}'; "
+                    "reference='{}'; ex='{:.1e}'; ev='{:.1e}'",
+                    path, plots_dir, fig, fig, label, chain, reference, m->error_x, m->error_v),
+        &why);
   }
   if (!ok) {
     fmt::print(stderr, "pwl reproduce: figures 7-9 not drawn: {}\n", why);
@@ -80,10 +83,11 @@ ChainFigureSummary reproduce_chain_figures(const std::string& plots_dir, bool qu
     fmt::print("figures 7-9: {0}/fig7.png, {0}/fig8.png, {0}/fig9.png\n", plots_dir);
   }
   summary.drawn = ok;
-  fmt::print("  largest error of x1: banded PIM {:.2e} m, dopri5 1e-5 {:.2e} m (ratio {:.1f}); "
-             "of x1': {:.2e} and {:.2e} m/s (ratio {:.1f})\n",
-             pim->error_x, rk->error_x, rk->error_x / pim->error_x, pim->error_v, rk->error_v,
-             rk->error_v / pim->error_v);
+  fmt::print(
+      "  largest error of x1: banded PIM {:.2e} m, dopri5 1e-5 {:.2e} m (ratio {:.1f}); "
+      "of x1': {:.2e} and {:.2e} m/s (ratio {:.1f})\n",
+      pim->error_x, rk->error_x, rk->error_x / pim->error_x, pim->error_v, rk->error_v,
+      rk->error_v / pim->error_v);
   return summary;
 }
 

@@ -56,8 +56,8 @@ std::vector<SceneRegime> run_paper_scenes(const std::string& self, const std::st
     r.paper_regime = paper;
     r.scene = fmt::format("{}/paper_fig{}.toml", scenes_directory(), figure);
     const std::string out = fmt::format("{}/data/scene_fig{}", plots_dir, figure);
-    std::string command = fmt::format("{} run {} --set output.out={}", shell_quoted(self), shell_quoted(r.scene),
-                                      shell_quoted(out));
+    std::string command = fmt::format("{} run {} --set output.out={}", shell_quoted(self),
+                                      shell_quoted(r.scene), shell_quoted(out));
     if (quick) command += " --set run.periods=400 --set analysis.transient=250";
     fmt::print("figure {}: pwl run {}\n", figure, r.scene);
     std::fflush(stdout);
@@ -66,7 +66,8 @@ std::vector<SceneRegime> run_paper_scenes(const std::string& self, const std::st
     r.lambda1 = line_after(printed, "lambda1: ");
     r.zero_one = line_after(printed, "0-1 test: ");
     if (r.regime.empty()) throw Error(fmt::format("{} printed no regime:\n{}", command, printed));
-    fmt::print("  the paper says {}, pwl finds {} (λ1 {}; {})\n", paper, r.regime, r.lambda1, r.zero_one);
+    fmt::print("  the paper says {}, pwl finds {} (λ1 {}; {})\n", paper, r.regime, r.lambda1,
+               r.zero_one);
     if (!quick) {
       std::filesystem::copy_file(out + "/analysis.png",
                                  fmt::format("{}/analysis_fig{}.png", plots_dir, figure),

@@ -52,24 +52,26 @@ void reproduce(const ReproduceOptions& o) {
     fmt::print("figure {}: integrating PIM and the dopri5 reference...\n", f);
     std::fflush(stdout);
     const FiveDofFigureResult r = reproduce_five_dof_figure(f, plots, o.quick);
-    const std::string line = fmt::format("| {} | {} | {} | {} | {:.2e} | {:.2e} | {:.3g} |\n",
-                                         r.figure, paper_points(f), r.distinct_points,
-                                         r.reference_distinct_points, r.largest_difference,
-                                         r.largest_poincare_difference, r.attractor_size);
-    fmt::print("{}  (PIM {:.2f} s, reference {:.2f} s)\n", line, r.pim_seconds, r.reference_seconds);
+    const std::string line =
+        fmt::format("| {} | {} | {} | {} | {:.2e} | {:.2e} | {:.3g} |\n", r.figure, paper_points(f),
+                    r.distinct_points, r.reference_distinct_points, r.largest_difference,
+                    r.largest_poincare_difference, r.attractor_size);
+    fmt::print("{}  (PIM {:.2f} s, reference {:.2f} s)\n", line, r.pim_seconds,
+               r.reference_seconds);
     report += line;
   }
   if (wanted(o, "5-6")) {
     const std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
     report +=
-        "\n## Figures 5 and 6: the shipped scenes apps/scenes/paper_fig5.toml and paper_fig6.toml\n\n"
+        "\n## Figures 5 and 6: the shipped scenes apps/scenes/paper_fig5.toml and "
+        "paper_fig6.toml\n\n"
         "| figure | paper says | pwl finds | λ1 (per forcing period) | 0-1 test | matches |\n"
         "|---|---|---|---|---|---|\n";
     for (const SceneRegime& r : run_paper_scenes(self, plots, o.quick)) {
       // λ1's error bar is a statistical one, so only the regime goes in the report.
-      report += fmt::format("| {} | {} | {} | {} | {} | {} |\n", r.figure, r.paper_regime,
-                            r.regime, r.lambda1.substr(0, r.lambda1.find(" ±")),
-                            r.zero_one, r.regime == r.paper_regime ? "yes" : "**no**");
+      report += fmt::format("| {} | {} | {} | {} | {} | {} |\n", r.figure, r.paper_regime, r.regime,
+                            r.lambda1.substr(0, r.lambda1.find(" ±")), r.zero_one,
+                            r.regime == r.paper_regime ? "yes" : "**no**");
     }
   }
   if (wanted(o, "7-9")) {
@@ -81,8 +83,8 @@ void reproduce(const ReproduceOptions& o) {
         "| banded PIM, η = 0.02 s | {:.2e} | {:.2e} |\n"
         "| dopri5, tol 1e-5 (plain, like ode45) | {:.2e} | {:.2e} |\n"
         "| ratio dopri5 / PIM (paper: about 10) | {:.1f} | {:.1f} |\n",
-        c.masses, o.quick ? 1e-10 : 1e-12, c.pim_error_x, c.pim_error_v, c.rk_error_x,
-        c.rk_error_v, c.rk_error_x / c.pim_error_x, c.rk_error_v / c.pim_error_v);
+        c.masses, o.quick ? 1e-10 : 1e-12, c.pim_error_x, c.pim_error_v, c.rk_error_x, c.rk_error_v,
+        c.rk_error_x / c.pim_error_x, c.rk_error_v / c.pim_error_v);
     if (!c.drawn) throw Error("figures 7-9 were computed but gnuplot could not draw them");
   }
   const std::string path = plots + (o.quick ? "/data/report_quick.md" : "/report.md");

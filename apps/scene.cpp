@@ -1,12 +1,12 @@
 #include "scene.hpp"
 
 #include <fmt/format.h>
+#include <toml++/toml.h>
 
 #include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
-#include <toml++/toml.h>
 
 #include "pwl/errors.hpp"
 
@@ -60,13 +60,20 @@ bool scalar_text(const toml::node& node, const std::string& at, const std::strin
 
 const char* type_name(const toml::node& node) {
   switch (node.type()) {
-    case toml::node_type::table: return "a table";
-    case toml::node_type::array: return "a list";
-    case toml::node_type::string: return "text";
-    case toml::node_type::integer: return "an integer";
-    case toml::node_type::floating_point: return "a number";
-    case toml::node_type::boolean: return "true or false";
-    default: return "a date or time";
+    case toml::node_type::table:
+      return "a table";
+    case toml::node_type::array:
+      return "a list";
+    case toml::node_type::string:
+      return "text";
+    case toml::node_type::integer:
+      return "an integer";
+    case toml::node_type::floating_point:
+      return "a number";
+    case toml::node_type::boolean:
+      return "true or false";
+    default:
+      return "a date or time";
   }
 }
 
@@ -94,13 +101,15 @@ SceneSetting setting_of(const std::string& section, const std::string& key, cons
     return s;
   }
   if (const auto* list = node.as_array()) {
-    if (list->empty()) throw InputError(fmt::format("{}: {}: expected values, got an empty list", at, dotted));
+    if (list->empty())
+      throw InputError(fmt::format("{}: {}: expected values, got an empty list", at, dotted));
     SceneSetting::Kind first = SceneSetting::Kind::text;
     for (std::size_t i = 0; i < list->size(); ++i) {
       SceneSetting::Kind kind;
       if (!scalar_text(*list->get(i), at, dotted, &text, &kind)) {
-        throw InputError(fmt::format("{}: {}: element {} of the list is {}; expected a number or text",
-                                     at, dotted, i + 1, type_name(*list->get(i))));
+        throw InputError(
+            fmt::format("{}: {}: element {} of the list is {}; expected a number or text", at,
+                        dotted, i + 1, type_name(*list->get(i))));
       }
       const bool numeric = kind != SceneSetting::Kind::text;
       if (i > 0 && numeric != (first != SceneSetting::Kind::text)) {
@@ -124,8 +133,9 @@ void collect(const toml::table& doc, const std::string& name, bool is_override, 
     if (section == "job") {
       const auto* job = node.as_string();
       if (job == nullptr) {
-        throw InputError(fmt::format("{}: job: expected text (simulate, analyze, sweep or map), got {}",
-                                     at, type_name(node)));
+        throw InputError(
+            fmt::format("{}: job: expected text (simulate, analyze, sweep or map), got {}", at,
+                        type_name(node)));
       }
       scene->job = job->get();
       continue;
@@ -146,15 +156,15 @@ void collect(const toml::table& doc, const std::string& name, bool is_override, 
       const std::string at2 = is_override ? name : where(name, value.source());
       if (section == "structure" && is_explicit_structure_key(k2)) {
         if (is_override) {
-          throw InputError(fmt::format("{}: structure.{} cannot be overridden; edit the scene file",
-                                       name, k2));
+          throw InputError(
+              fmt::format("{}: structure.{} cannot be overridden; edit the scene file", name, k2));
         }
         scene->explicit_structure = true;
         continue;
       }
       if (value.is_table()) {
-        throw InputError(fmt::format("{}: {}.{}: sections do not nest; expected a value, got a table",
-                                     at2, section, k2));
+        throw InputError(fmt::format(
+            "{}: {}.{}: sections do not nest; expected a value, got a table", at2, section, k2));
       }
       SceneSetting s = setting_of(section, k2, value, at2);
       s.position = static_cast<long>(value.source().begin.line) * 100000 +
@@ -193,8 +203,8 @@ std::string screen_scene_text(std::string_view text, const std::string& name) {
     throw InputError(fmt::format("{}:{}:{}: {}", name, line, column, what));
   };
   const auto key_start = [](char c) {
-    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
-           c == '_' || c == '-' || c == '"' || c == '\'';
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
+           c == '-' || c == '"' || c == '\'';
   };
   while (i < text.size()) {
     const char c = text[i];
@@ -217,8 +227,9 @@ std::string screen_scene_text(std::string_view text, const std::string& name) {
       if (expect != Expect::nothing && c != '\n' && c != '#') {
         const bool ok = expect == Expect::key          ? key_start(c)
                         : expect == Expect::key_or_end ? key_start(c) || c == '}'
-                        : expect == Expect::element    ? std::string_view("},=#").find(c) == std::string_view::npos
-                                                       : std::string_view("}],=").find(c) == std::string_view::npos;
+                        : expect == Expect::element
+                            ? std::string_view("},=#").find(c) == std::string_view::npos
+                            : std::string_view("}],=").find(c) == std::string_view::npos;
         if (!ok) {
           fail(expect == Expect::key || expect == Expect::key_or_end ? "a key is missing"
                                                                      : "a value is missing");
@@ -327,8 +338,9 @@ Scene parse_scene(std::string_view text, const std::string& name,
   scene.name = name;
   collect(parse_toml(text, name), name, false, &scene);
   // Tables iterate by key; the flags follow the file's order instead.
-  std::stable_sort(scene.settings.begin(), scene.settings.end(),
-                   [](const SceneSetting& a, const SceneSetting& b) { return a.position < b.position; });
+  std::stable_sort(
+      scene.settings.begin(), scene.settings.end(),
+      [](const SceneSetting& a, const SceneSetting& b) { return a.position < b.position; });
   for (const std::string& o : overrides) {
     const std::string at = fmt::format("--set {}", o);
     const std::size_t eq = o.find('=');
@@ -343,7 +355,8 @@ Scene parse_scene(std::string_view text, const std::string& name,
         dot == std::string::npos
             ? fmt::format("{} = ", key)
             : fmt::format("[{}]\n{} = ", key.substr(0, dot), key.substr(dot + 1));
-    if (dot != std::string::npos && (!valid_key(key.substr(0, dot)) || !valid_key(key.substr(dot + 1)))) {
+    if (dot != std::string::npos &&
+        (!valid_key(key.substr(0, dot)) || !valid_key(key.substr(dot + 1)))) {
       throw InputError(fmt::format("{}: '{}' is not a key: section.key, lowercase", at, key));
     }
     if (dot == std::string::npos && key != "job") {

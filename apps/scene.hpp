@@ -51,9 +51,9 @@ struct SceneSetting {
   std::string flag;                 // "--tol"
   std::vector<std::string> values;  // the flag's arguments (none for a switch that is on)
   Kind kind = Kind::text;
-  bool switched_on = true;          // a boolean: whether the switch is given at all
-  std::string where;                // "file:line:column" of the value, or "--set key=value"
-  long position = 0;                // line and column in the file (for its order)
+  bool switched_on = true;  // a boolean: whether the switch is given at all
+  std::string where;        // "file:line:column" of the value, or "--set key=value"
+  long position = 0;        // line and column in the file (for its order)
 };
 
 struct Scene {

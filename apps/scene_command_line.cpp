@@ -17,11 +17,16 @@ std::string flag_of_token(const std::string& token) {
 
 const char* kind_name(SceneSetting::Kind kind) {
   switch (kind) {
-    case SceneSetting::Kind::boolean: return "true or false";
-    case SceneSetting::Kind::integer: return "an integer";
-    case SceneSetting::Kind::real: return "a number";
-    case SceneSetting::Kind::text: return "text";
-    case SceneSetting::Kind::list: return "a list";
+    case SceneSetting::Kind::boolean:
+      return "true or false";
+    case SceneSetting::Kind::integer:
+      return "an integer";
+    case SceneSetting::Kind::real:
+      return "a number";
+    case SceneSetting::Kind::text:
+      return "text";
+    case SceneSetting::Kind::list:
+      return "a list";
   }
   return "a value";
 }
@@ -37,8 +42,8 @@ void check_setting(const SceneSetting& s, const CLI::App& job) {
           name != "--scene" && name != "--set") {
         std::string key = name.substr(2);
         std::replace(key.begin(), key.end(), '-', '_');
-        if (key == "n") key = "masses";       // structure.masses
-        if (key == "method") key = "name";    // method.name
+        if (key == "n") key = "masses";     // structure.masses
+        if (key == "method") key = "name";  // method.name
         known.push_back(key);
       }
     }
@@ -67,8 +72,8 @@ void check_setting(const SceneSetting& s, const CLI::App& job) {
     }
   }
   if (!expected.empty()) {
-    throw InputError(fmt::format("{}: {}: expected {}, got {}", s.where, s.key, expected,
-                                 kind_name(s.kind)));
+    throw InputError(
+        fmt::format("{}: {}: expected {}, got {}", s.where, s.key, expected, kind_name(s.kind)));
   }
 }
 
@@ -100,7 +105,8 @@ ExpandedCommandLine expand_scenes(const std::vector<std::string>& args, const CL
       return args[++i];
     };
     if (a == "--scene" || a.rfind("--scene=", 0) == 0) {
-      if (!path.empty()) throw InputError(fmt::format("--scene {}: only one scene per run", value_of("--scene")));
+      if (!path.empty())
+        throw InputError(fmt::format("--scene {}: only one scene per run", value_of("--scene")));
       path = value_of("--scene");
     } else if (a == "--set" || a.rfind("--set=", 0) == 0) {
       overrides.push_back(value_of("--set"));
@@ -116,7 +122,9 @@ ExpandedCommandLine expand_scenes(const std::vector<std::string>& args, const CL
   const Scene scene = load_scene(path, overrides);
   if (job.empty()) {
     job = scene.job;
-    if (job.empty()) throw InputError(fmt::format("{}: job: the scene does not say which job it is (job = \"simulate\", ...)", path));
+    if (job.empty())
+      throw InputError(fmt::format(
+          "{}: job: the scene does not say which job it is (job = \"simulate\", ...)", path));
   }
   const CLI::App* sub = nullptr;
   try {
@@ -139,7 +147,9 @@ ExpandedCommandLine expand_scenes(const std::vector<std::string>& args, const CL
     if (std::find(typed.begin(), typed.end(), s.flag) == typed.end()) kept.settings.push_back(s);
   }
   if (scene.explicit_structure && sub->get_option_no_throw("--structure-scene") == nullptr) {
-    throw InputError(fmt::format("{}: structure: pwl {} takes only the chain's parameters, not an explicit structure", path, job));
+    throw InputError(fmt::format(
+        "{}: structure: pwl {} takes only the chain's parameters, not an explicit structure", path,
+        job));
   }
   const std::vector<std::string> scene_args = scene_arguments(kept);
   out.args.insert(out.args.end(), scene_args.begin(), scene_args.end());
@@ -153,7 +163,9 @@ std::string locate_in_scene(const std::string& message, const ExpandedCommandLin
     const std::size_t at = message.find(s.flag);
     if (at == std::string::npos) continue;
     const std::size_t end = at + s.flag.size();
-    if (end < message.size() && (std::isalnum(static_cast<unsigned char>(message[end])) || message[end] == '-')) continue;
+    if (end < message.size() &&
+        (std::isalnum(static_cast<unsigned char>(message[end])) || message[end] == '-'))
+      continue;
     return fmt::format("{} (set by {}: {})", message, s.where, s.key);
   }
   return message;
@@ -163,19 +175,21 @@ void add_scene_options(CLI::App& job) {
   // Consumed by expand_scenes before parsing; declared here for --help.
   static std::string unused_path;
   static std::vector<std::string> unused_overrides;
-  job.add_option("--scene", unused_path, "Take the settings from this scene file (TOML); typed flags win")
+  job.add_option("--scene", unused_path,
+                 "Take the settings from this scene file (TOML); typed flags win")
       ->group("Scene");
-  job.add_option("--set", unused_overrides, "Override one scene setting: key=value, e.g. structure.theta=1.3")
+  job.add_option("--set", unused_overrides,
+                 "Override one scene setting: key=value, e.g. structure.theta=1.3")
       ->group("Scene");
 }
 
 void add_run_command(CLI::App& app) {
   static std::string unused_path;
   static std::vector<std::string> unused_overrides;
-  CLI::App* c = app.add_subcommand(
-      "run",
-      "Run the job a scene file describes (simulate, analyze, sweep or map)\n"
-      "Example: pwl run apps/scenes/paper_fig4b.toml --set structure.theta=1.1");
+  CLI::App* c =
+      app.add_subcommand("run",
+                         "Run the job a scene file describes (simulate, analyze, sweep or map)\n"
+                         "Example: pwl run apps/scenes/paper_fig4b.toml --set structure.theta=1.1");
   c->add_option("scene", unused_path, "The scene file")->required();
   c->add_option("--set", unused_overrides, "Override one scene setting: key=value");
   c->callback([] { throw InputError("pwl run: the scene could not be expanded"); });

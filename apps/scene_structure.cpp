@@ -1,12 +1,12 @@
 #include "scene_structure.hpp"
 
 #include <fmt/format.h>
+#include <toml++/toml.h>
 
 #include <cmath>
 #include <fstream>
 #include <optional>
 #include <sstream>
-#include <toml++/toml.h>
 
 #include "pwl/errors.hpp"
 #include "scene.hpp"
@@ -30,16 +30,17 @@ double number(const toml::node& node, const std::string& name, const std::string
 Matrix matrix(const toml::node& node, const std::string& name, const std::string& key) {
   const auto* rows = node.as_array();
   if (rows == nullptr || rows->empty()) {
-    throw InputError(fmt::format("{}: {}: expected a matrix as a list of rows, e.g. [[1, 0], [0, 1]]",
-                                 at(name, node), key));
+    throw InputError(fmt::format(
+        "{}: {}: expected a matrix as a list of rows, e.g. [[1, 0], [0, 1]]", at(name, node), key));
   }
   const auto n = static_cast<Index>(rows->size());
   Matrix m(n, n);
   for (Index i = 0; i < n; ++i) {
     const auto* row = rows->get(static_cast<std::size_t>(i))->as_array();
     if (row == nullptr || static_cast<Index>(row->size()) != n) {
-      throw InputError(fmt::format("{}: {}: row {} must be a list of {} numbers (the matrix is square)",
-                                   at(name, *rows->get(static_cast<std::size_t>(i))), key, i + 1, n));
+      throw InputError(
+          fmt::format("{}: {}: row {} must be a list of {} numbers (the matrix is square)",
+                      at(name, *rows->get(static_cast<std::size_t>(i))), key, i + 1, n));
     }
     for (Index j = 0; j < n; ++j) {
       m(i, j) = number(*row->get(static_cast<std::size_t>(j)), name,
@@ -55,8 +56,8 @@ class Entry {
   Entry(const toml::node& node, const std::string& name, std::string key)
       : name_(name), key_(std::move(key)), node_(node), table_(node.as_table()) {
     if (table_ == nullptr) {
-      throw InputError(fmt::format("{}: {}: expected a table like {{ mass = 1, ... }}", at(name_, node),
-                                   key_));
+      throw InputError(
+          fmt::format("{}: {}: expected a table like {{ mass = 1, ... }}", at(name_, node), key_));
     }
   }
   // Rejects keys outside `allowed`.
@@ -100,8 +101,9 @@ const toml::array* list(const toml::table& s, std::string_view key, const std::s
   if (node == nullptr) return nullptr;
   const auto* a = node->as_array();
   if (a == nullptr) {
-    throw InputError(fmt::format("{}: structure.{}: expected a list of tables, e.g. [{{ mass = 1, ... }}]",
-                                 at(name, *node), key));
+    throw InputError(
+        fmt::format("{}: structure.{}: expected a list of tables, e.g. [{{ mass = 1, ... }}]",
+                    at(name, *node), key));
   }
   return a;
 }
@@ -114,13 +116,13 @@ GapStructure parse_scene_structure(std::string_view text, const std::string& nam
   try {
     doc = toml::parse(screened, name);
   } catch (const toml::parse_error& e) {
-    throw InputError(fmt::format("{}:{}:{}: {}", name, e.source().begin.line, e.source().begin.column,
-                                 e.description()));
+    throw InputError(fmt::format("{}:{}:{}: {}", name, e.source().begin.line,
+                                 e.source().begin.column, e.description()));
   }
   const toml::table* s = doc["structure"].as_table();
   if (s == nullptr || s->get("mass") == nullptr) {
-    throw InputError(fmt::format("{}: structure.mass: an explicit structure needs its mass matrix",
-                                 name));
+    throw InputError(
+        fmt::format("{}: structure.mass: an explicit structure needs its mass matrix", name));
   }
   const Matrix m = matrix(*s->get("mass"), name, "structure.mass");
   const Index n = m.rows();

@@ -1,6 +1,7 @@
 #include "study_runner.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <cmath>
@@ -181,14 +182,13 @@ void run_distributed(const Study& study, const RunFlags& flags, const Distribute
   std::string computed;
   {
     ProgressBar bar(todo, "points", !flags.quiet && world.rank() == 0);
-    analysis::run_grid(
-        mine, study.chain_of, study.initial_state, study.settings, done,
-        [&](long id, const analysis::PointResult& r) {
-          journal->append(id, r);
-          if (world.size() > 1) computed += analysis::encode_record(id, r);
-          bar.advance();
-        },
-        {flags.threads});
+    analysis::run_grid(mine, study.chain_of, study.initial_state, study.settings, done,
+                       [&](long id, const analysis::PointResult& r) {
+                         journal->append(id, r);
+                         if (world.size() > 1) computed += analysis::encode_record(id, r);
+                         bar.advance();
+                       },
+                       {flags.threads});
   }
   journal.reset();
   const std::vector<std::string> gathered = world.gather(computed);
@@ -235,6 +235,31 @@ void run_study(const Study& study, const RunFlags& flags) {
     fmt::print(stderr, "pwl (rank {}): {}\n", world.rank(), e.what());
     world.abort(1);
   }
+}
+
+std::string parameter_label(analysis::SweepParameter parameter) {
+  switch (parameter) {
+    case analysis::SweepParameter::theta:
+      return "θ = ω/ω_0";
+    case analysis::SweepParameter::alpha:
+      return "α = k_2/k_1";
+    case analysis::SweepParameter::zeta:
+      return "ζ (damping ratio)";
+    case analysis::SweepParameter::gap:
+      return "Δ̃ (nondimensional gap)";
+    case analysis::SweepParameter::amplitude:
+      return "load scale (times Q)";
+  }
+  return analysis::parameter_name(parameter);
+}
+
+std::string study_title(const NondimensionalChain& chain, const analysis::PointSettings& point) {
+  return fmt::format(
+      "base case: {} masses, α = {}, ζ = {}, Δ̃ = {}, θ = {}, Q = ({}); {} + {} periods per point, "
+      "η = T/{}",
+      chain.masses, fmt::join(chain.alpha, ","), chain.zeta, fmt::join(chain.gap, ","), chain.theta,
+      fmt::join(chain.amplitude, ","), point.transient_periods, point.recorded_periods,
+      point.steps_per_period);
 }
 
 }  // namespace pwl::app

@@ -72,4 +72,10 @@ void run_study(const Study& study, const RunFlags& flags);
 // Parses a range "a:b" into its ends; throws InputError naming the flag otherwise.
 void parse_range(const std::string& flag, const std::string& text, double* from, double* to);
 
+// Figure text: the axis label of a swept parameter ("θ = ω/ω0"), and a title line stating the
+// base case and the integration ("base case: 5 masses, α = 5, ζ = 0.2, Δ̃ = 0, Q = (1,-1,1,-1,1);
+// 300 + 200 periods per point, η = T/200"). Single quotes are left out (gnuplot strings).
+std::string parameter_label(analysis::SweepParameter parameter);
+std::string study_title(const NondimensionalChain& chain, const analysis::PointSettings& point);
+
 }  // namespace pwl::app

@@ -56,11 +56,14 @@ void sweep(const SweepFlags& f) {
     std::string why;
     const std::string definitions = fmt::format(
         "poincare='{0}/poincare.csv'; classes='{0}/classification.csv'; out='{0}/bifurcation.png'; "
-        "column=5; xname='{1}'; yname='{2}'",
-        f.run.out, analysis::parameter_name(o.parameter),
+        "column=5; xname='{1}'; yname='{2} at t = kT (nondimensional)'; title='{3}'",
+        f.run.out, parameter_label(o.parameter),
         o.point.components.empty() ? std::string("x")
                                    : analysis::component_name(o.point.components[0],
-                                                              o.chain.masses));
+                                                              o.chain.masses),
+        fmt::format("pwl sweep of {} ({}): {}", analysis::parameter_name(o.parameter),
+                    o.mode == analysis::SweepMode::continuation ? "continuation" : "independent",
+                    study_title(o.chain, o.point)));
     if (run_gnuplot(plots_directory() + "/bifurcation.gp", definitions, &why)) {
       fmt::print("wrote {}/bifurcation.png\n", f.run.out);
     } else {

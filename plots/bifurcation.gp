@@ -2,13 +2,14 @@
 # component against the swept parameter, the upward and downward continuation branches in two
 # colours, and below them a strip coloured by the regime of every point.
 # Variables (gnuplot -e): poincare, classes (CSV files of pwl sweep), out (PNG), column (the
-# column of poincare.csv to draw, 5 = the first recorded component), xname, yname.
+# column of poincare.csv to draw, 5 = the first recorded component), xname, yname, title.
 if (!exists("poincare")) poincare = 'plots/data/theta_sweep/poincare.csv'
 if (!exists("classes")) classes = 'plots/data/theta_sweep/classification.csv'
 if (!exists("out")) out = 'plots/bifurcation.png'
 if (!exists("column")) column = 5
 if (!exists("xname")) xname = 'theta'
 if (!exists("yname")) yname = 'x5'
+if (!exists("title")) title = ''
 set datafile separator ','
 set terminal pngcairo size 1400,900 font 'DejaVu Sans,12'
 set output out
@@ -17,7 +18,7 @@ set output out
 color(c) = c == 1 ? 0x1f77b4 : c == 2 ? 0x2ca02c : c == 3 ? 0x17becf : c == 4 ? 0x9467bd : \
            c <= 8 ? 0x8c564b : c == 9 ? 0xbcbd22 : c == 10 ? 0xff7f0e : c == 11 ? 0xd62728 : \
            c == 12 ? 0x000000 : 0x7f7f7f
-set multiplot
+set multiplot title title font 'DejaVu Sans,11'
 set lmargin at screen 0.09
 set rmargin at screen 0.80
 set tmargin at screen 0.95

@@ -7,6 +7,7 @@ if (!exists("out")) out = 'plots/regime_map.png'
 if (!exists("out_lambda")) out_lambda = 'plots/lambda1_map.png'
 if (!exists("xname")) xname = 'theta'
 if (!exists("yname")) yname = 'alpha'
+if (!exists("subtitle")) subtitle = ''
 if (!exists("dx")) dx = 0.1
 if (!exists("dy")) dy = 1.0
 set datafile separator ','
@@ -19,11 +20,11 @@ set xlabel xname
 set ylabel yname
 set key outside right top
 stats data using 3 nooutput
-set xrange [STATS_min - dx/2 : STATS_max + dx/2]
+set xrange [STATS_min - dx/2.0 : STATS_max + dx/2.0]
 stats data using 4 nooutput
-set yrange [STATS_min - dy/2 : STATS_max + dy/2]
-set title 'regime of the motion'
-plot data using 3:4:(dx/2):(dy/2):(color($6)) with boxxyerror fs solid 1.0 noborder \
+set yrange [STATS_min - dy/2.0 : STATS_max + dy/2.0]
+set title 'regime of the motion'.(subtitle eq '' ? '' : "\n{/*0.8 ".subtitle."}")
+plot data using 3:4:(dx/2.0):(dy/2.0):(color($6)) with boxxyerror fs solid 1.0 noborder \
        lc rgb variable notitle, \
      NaN with boxes fs solid lc rgb '#1f77b4' title 'period-1', \
      NaN with boxes fs solid lc rgb '#2ca02c' title 'period-2', \
@@ -36,10 +37,10 @@ plot data using 3:4:(dx/2):(dy/2):(color($6)) with boxxyerror fs solid 1.0 nobor
      NaN with boxes fs solid lc rgb '#000000' title 'unbounded', \
      NaN with boxes fs solid lc rgb '#7f7f7f' title 'uncertain'
 set output out_lambda
-set title 'largest Lyapunov exponent λ1 per forcing period'
+set title 'largest Lyapunov exponent λ1 per forcing period'.(subtitle eq '' ? '' : "\n{/*0.8 ".subtitle."}")
 set palette defined (-0.5 '#08306b', -0.05 '#c6dbef', 0 '#ffffff', 0.05 '#fcbba1', 0.5 '#67000d')
 set cbrange [-0.5:0.5]
 set cblabel 'λ1'
 unset key
-plot data using 3:4:(dx/2):(dy/2):(strcol(8) eq '' ? NaN : $8) with boxxyerror fs solid 1.0 \
+plot data using 3:4:(dx/2.0):(dy/2.0):(strcol(8) eq '' ? NaN : $8) with boxxyerror fs solid 1.0 \
        noborder lc palette

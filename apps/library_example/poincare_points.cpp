@@ -3,14 +3,13 @@
 // are from the exact event-driven solution of the same motion.
 //
 //   x'' + 0.1 x' + x + 4 max(0, x - 0.2) = sin(1.2 t)
-#include <pwl/event_driven_solver.hpp>
-#include <pwl/gap_structure.hpp>
-#include <pwl/pim_integrator.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <pwl/event_driven_solver.hpp>
+#include <pwl/gap_structure.hpp>
+#include <pwl/pim_integrator.hpp>
 
 int main() {
   pwl::GapStructure s;
@@ -23,7 +22,8 @@ int main() {
   const double period = 2 * std::numbers::pi / 1.2;
   auto pim = pwl::make_pim_integrator(s, {.step = period / 200});
   auto exact = pwl::make_event_driven_solver(s);
-  for (auto* m : {pim.get(), exact.get()}) m->set_state(0.0, pwl::Vector::Zero(1), pwl::Vector::Zero(1));
+  for (auto* m : {pim.get(), exact.get()})
+    m->set_state(0.0, pwl::Vector::Zero(1), pwl::Vector::Zero(1));
 
   double largest = 0.0;
   std::printf("period     x (PIM)        x' (PIM)\n");
