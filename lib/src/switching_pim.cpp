@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <fmt/format.h>
 
 #include "event_location.hpp"
@@ -271,6 +273,19 @@ class Stepper final : public SwitchingPim {
                                    eta_, why));
     }
     if (m_ > 0) solver_->set_matrix(ops.lcp_matrix);
+    lcp_matrix_ = ops.lcp_matrix;
+    const double mmax = m_ > 0 ? lcp_matrix_.cwiseAbs().maxCoeff() : 0.0;
+    lcp_scale_ = mmax > 0.0 ? mmax : 1.0;
+    inline_lcp_ = o.lcp_solver == "block-pivoting";
+    // The per-mode operators take at most one load group (its harmonic response and load in
+    // the same group); more frequencies take the Taylor recursion in every step.
+    mode_cached_ = kModeCache && loads_.size() <= 1 && harmonics_.size() == loads_.size() &&
+                   m_ <= kMaxCachedSprings;
+    if (mode_cached_) mode_ops_.resize(std::size_t{1} << m_);
+    for (const Load& l : loads_) {
+      rotations_.push_back({std::cos(l.omega * eta_), std::sin(l.omega * eta_)});
+    }
+    phases_ = Phases(0.0, 0.0, 1.0);
     const int terms = std::max(o.max_series_terms, d_ + 2) + 1;
     xs_.assign(static_cast<std::size_t>(terms), Half::Zero(n_));
     us_.assign(static_cast<std::size_t>(terms), Half::Zero(n_));
@@ -281,10 +296,13 @@ class Stepper final : public SwitchingPim {
     state_ = State::Zero(2 * n_);
     bar_ = state_;
     z_ = Force::Zero(m_);
+    lcp_x_ = z_;
+    scaled_velocity_ = Half::Zero(n_);
     w_ = z_;
     q_ = z_;
     position_ = Vector::Zero(n_);
     velocity_ = position_;
+    anchor_phases();
   }
 
   std::string name() const override {
@@ -316,6 +334,7 @@ class Stepper final : public SwitchingPim {
     const Force g = gap_rows_ * state_.head(n_) - gaps_;
     for (Index j = 0; j < m_; ++j) set_mode(j, g[j] > 0.0);
     x_scale_ = x.cwiseAbs().maxCoeff();
+    anchor_phases();
     sync();
   }
 
@@ -347,6 +366,34 @@ class Stepper final : public SwitchingPim {
   struct Load {
     double omega;
     Half sin_part, cos_part;
+  };
+  struct Rotation {
+    double cos_step, sin_step;  // cos ωη, sin ωη
+  };
+  // The phases sin ωt, cos ωt of the (at most one) load group and 1, and their coefficients.
+  using Phases = Eigen::Vector3d;
+  using StateLoad = Eigen::Matrix<double, kState, 3>;
+  using ForceLoad = Eigen::Matrix<double, Springs, 3>;
+  using ForceStateRows = Eigen::Matrix<double, Springs, kState, Eigen::RowMajor>;
+  using ForceSquare = Eigen::Matrix<double, Springs, Springs>;
+  // The smooth step in one mode, affine in the state v and in the phases (sin ωt, cos ωt of
+  // the load group, 0 and 0 without one, and 1):
+  //   bar = bar v + bar_load phases (the predicted end slope folded in),
+  //   gw_r = gap[r] v + gap_load[r] phases (r = 0..d+1, the gap coefficients of the screen;
+  //          row-major, so that each entry is one contiguous dot product; r = 0, 1 do not
+  //          depend on the mode and the step computes them directly),
+  //   p_r = touching gw_r for r >= 1 (touching = mode K2),
+  //   slope at the end = slope_rows x'_{k+1} (η mode K2 W^T),
+  // and the LCP transform of the mode as active set.
+  struct ModeOps {
+    StateSquare bar;
+    StateLoad bar_load;
+    std::vector<ForceStateRows> gap;
+    std::vector<ForceLoad> gap_load;
+    Force touching;
+    ForceHalf slope_rows;
+    ForceSquare lcp_transform;
+    bool lcp_ready = false;
   };
 
   // The displacement and velocity halves of a state, as fixed-size blocks when the sizes are
@@ -382,6 +429,10 @@ class Stepper final : public SwitchingPim {
   void set_mode(Index j, bool on) {
     mode_[j] = on ? 1.0 : 0.0;
     signs_[j] = on ? 1.0 : -1.0;
+    if (j < 64) {
+      const std::uint64_t bit = std::uint64_t{1} << j;
+      mode_mask_ = on ? (mode_mask_ | bit) : (mode_mask_ & ~bit);
+    }
   }
 
   void sync() {
@@ -507,7 +558,114 @@ class Stepper final : public SwitchingPim {
     return !flip_.empty();
   }
 
+  // One step. With fixed sizes and at most one load group, the smooth step uses the operators
+  // of the current mode, in which everything before the LCP is affine in the state and in
+  // sin ωt, cos ωt (see ModeOps); otherwise, and for every switching step, the Taylor recursion
+  // of taylor().
   void step() {
+    if (mode_cached_) {
+      step_cached();
+    } else {
+      step_direct();
+    }
+  }
+
+  // The smooth step on the mode's combined operators: the same quantities as step_direct()
+  // computes through the Taylor recursion, up to rounding.
+  void step_cached() {
+    const double t = time();
+    const ModeOps& op = mode_ops();
+    // The first two gap terms, W^T x and η W^T x', are the same in every mode.
+    gw_[0].noalias() = mul(gap_rows_, upper(state_, n_));
+    scaled_velocity_ = eta_ * lower(state_, n_);
+    gw_[1].noalias() = mul(gap_rows_, scaled_velocity_);
+    const auto terms = static_cast<std::size_t>(d_ + 2);
+    for (std::size_t r = 2; r < terms; ++r) {
+      gw_[r].noalias() = mul(op.gap[r], state_);
+      gw_[r].noalias() += mul(op.gap_load[r], phases_);
+    }
+    if (o_.locate_switches && screen_fails()) {
+      ++diagnostics_.screened;
+      taylor(t, eta_, state_, d_ + 1, 0.0, false);  // the data switching_step() continues
+      switching_step(t);
+      return;
+    }
+    bar_.noalias() = mul(op.bar, state_);
+    bar_.noalias() += mul(op.bar_load, phases_);
+    if (end_derivative_) {
+      // The end slope η P'(t_{k+1}) the start's Taylor data predict, Σ_{r=1}^{d+1} r p_r with
+      // p_r = mode K2 gw_r for r >= 1.
+      slope_guess_ = static_cast<double>(d_ + 1) * gw_[static_cast<std::size_t>(d_ + 1)];
+      for (int r = 1; r <= d_; ++r) {
+        slope_guess_ += static_cast<double>(r) * gw_[static_cast<std::size_t>(r)];
+      }
+      slope_guess_ = op.touching.cwiseProduct(slope_guess_);
+    }
+    q_.noalias() = spring_offset_ - mul(spring_rows_, upper(bar_, n_));
+    if (m_ > 0 && !solve_warm(op)) {
+      z_ = mode_;
+      stats_.lcp_pivots += solver_->solve(q_, z_, w_).pivots;
+    }
+    if (o_.locate_switches) {
+      for (Index j = 0; j < m_; ++j) {
+        if ((z_[j] > 0.0) != (mode_[j] > 0.0)) {
+          ++diagnostics_.lcp_mismatches;
+          taylor(t, eta_, state_, d_ + 1, 0.0, false);
+          switching_step(t);
+          return;
+        }
+      }
+    } else {
+      for (Index j = 0; j < m_; ++j) set_mode(j, z_[j] > 0.0);
+    }
+    // Φ z and the slope correction over the springs that carry a force only: the others'
+    // columns are multiplied by zero (few springs touch at a time).
+    state_ = bar_;
+    for (Index j = 0; j < m_; ++j) {
+      if (z_[j] != 0.0) state_ += z_[j] * phi_.col(j);
+    }
+    if (end_derivative_ && o_.locate_switches && mode_mask_ != 0) {
+      // Correct with the slope the new state gives (the mode is the same at both ends); both
+      // slopes vanish on the slack springs.
+      slope_guess_ = mul(op.slope_rows, lower(state_, n_)) - slope_guess_;
+      for (Index j = 0; j < m_; ++j) {
+        if (mode_[j] > 0.0) state_ += slope_guess_[j] * slope_.col(j);
+      }
+    }
+    finish_step();
+  }
+
+  // The LCP for q_ when the block-pivoting solver's first iterate from the warm start (the
+  // current mode) already solves it, as it does in every smooth step: z = 0 when q is
+  // non-negative, else x = T_A q with the mode's transform. The same test and tolerances as the
+  // solver (lcp_solver.cpp), without its input checks and the virtual call. Returns false
+  // (z_ untouched) when it cannot decide: another solver, a non-finite q, or an infeasible
+  // iterate, which the solver then pivots away.
+  bool solve_warm(const ModeOps& op) {
+    if (!inline_lcp_ || !op.lcp_ready) return false;
+    double qmax = 0.0, qmin = std::numeric_limits<double>::infinity();
+    for (Index i = 0; i < m_; ++i) {
+      const double v = q_[i];
+      if (!std::isfinite(v)) return false;
+      qmax = std::max(qmax, std::abs(v));
+      qmin = std::min(qmin, v);
+    }
+    const double tol_w = kLcpFeasTol * qmax;
+    const double tol_z = tol_w / lcp_scale_;
+    if (qmin >= -tol_w) {  // z = 0 solves it
+      z_.setZero();
+      return true;
+    }
+    lcp_x_.noalias() = mul(op.lcp_transform, q_);
+    for (Index i = 0; i < m_; ++i) {
+      const double tol = mode_[i] > 0.0 ? tol_z : tol_w;
+      if (lcp_x_[i] < -tol) return false;
+    }
+    for (Index i = 0; i < m_; ++i) z_[i] = mode_[i] > 0.0 ? std::max(lcp_x_[i], 0.0) : 0.0;
+    return true;
+  }
+
+  void step_direct() {
     const double t = time();
     // Taylor data of the force over the step (and one more gap term for the screen).
     taylor(t, eta_, state_, d_ + 1, 0.0, false);
@@ -630,6 +788,7 @@ class Stepper final : public SwitchingPim {
     ++steps_;
     ++stats_.steps;
     ++diagnostics_.steps;
+    advance_phases();
     const double largest = state_.cwiseAbs().maxCoeff();
     x_scale_ = std::max(x_scale_, upper(state_, n_).cwiseAbs().maxCoeff());
     if (!(largest <= o_.divergence_bound)) {
@@ -638,6 +797,155 @@ class Stepper final : public SwitchingPim {
           time(), largest, o_.divergence_bound));
     }
   }
+
+  // sin ωt and cos ωt of the load group (the per-mode path takes at most one) at the step
+  // start, in phases_. Advanced by the fixed rotation through ωη each step and re-anchored to
+  // std::sin, std::cos every kReanchorSteps steps, so the rotation's rounding stays within a
+  // few ulps (as the plain PIM's propagator does).
+  void anchor_phases() {
+    if (!mode_cached_ || loads_.empty()) return;
+    const double t = time();
+    phases_[0] = std::sin(loads_[0].omega * t);
+    phases_[1] = std::cos(loads_[0].omega * t);
+  }
+
+  void advance_phases() {
+    if (!mode_cached_ || loads_.empty()) return;
+    if (steps_ % kReanchorSteps == 0) {
+      anchor_phases();
+      return;
+    }
+    const double sn = phases_[0], cs = phases_[1];
+    const Rotation& rot = rotations_[0];
+    phases_[0] = sn * rot.cos_step + cs * rot.sin_step;
+    phases_[1] = cs * rot.cos_step - sn * rot.sin_step;
+  }
+
+  // The operators of the current mode, built the first time the mode is met.
+  const ModeOps& mode_ops() {
+    std::unique_ptr<ModeOps>& slot = mode_ops_[static_cast<std::size_t>(mode_mask_)];
+    if (!slot) slot = build_mode_ops();
+    return *slot;
+  }
+
+  // For the current mode, the smooth step's affine maps, found by running the recursion of
+  // taylor() (h = η, terms up to d + 1) on the columns of [I_2n, phase terms]: the column of
+  // sin ωt (cos ωt) of the load group is the response to that phase, the last column the
+  // constant part (the spring offsets K2 Δ in p_0).
+  std::unique_ptr<ModeOps> build_mode_ops() const {
+    const Index n = n_, m = m_;
+    const auto groups = static_cast<Index>(loads_.size());
+    const Index cols = 2 * n + 2 * groups + 1;
+    const Index first_phase = 2 * n, constant = cols - 1;
+    const Vector mode = mode_;
+    const Vector touching = mode.cwiseProduct(Vector(stiffnesses_));  // mode K2
+    const Matrix W_t = gap_rows_;
+    const Matrix K_part = stiffness_part_, C_part = damping_part_, F_part = force_part_;
+    const auto terms = static_cast<std::size_t>(d_ + 2);
+    std::vector<Matrix> xs(terms), us(terms), ps(terms), gw(terms);
+    xs[0] = Matrix::Zero(n, cols);
+    xs[0].leftCols(n).setIdentity();
+    us[0] = Matrix::Zero(n, cols);
+    us[0].middleCols(n, n).setIdentity();
+    gw[0] = W_t * xs[0];
+    std::vector<double> scale(loads_.size(), 1.0);
+    for (int r = 0; r <= d_; ++r) {
+      const auto ru = static_cast<std::size_t>(r);
+      ps[ru] = touching.asDiagonal() * gw[ru];
+      if (r == 0) ps[ru].col(constant) -= mode.cwiseProduct(Vector(spring_offset_));
+      const double f = eta_ / (r + 1);
+      xs[ru + 1] = f * us[ru];
+      gw[ru + 1] = W_t * xs[ru + 1];
+      if (r == d_) break;
+      Matrix acc = K_part * xs[ru] + C_part * us[ru] + F_part * ps[ru];
+      for (std::size_t g = 0; g < loads_.size(); ++g) {
+        // The cycle (S, C, -S, -C) of taylor() as coefficients of sin ωt and cos ωt.
+        const Index cs = first_phase + 2 * static_cast<Index>(g), cc = cs + 1;
+        const Vector sp = loads_[g].sin_part, cp = loads_[g].cos_part;
+        const double a = scale[g];
+        if (a != 0.0) {
+          switch (r % 4) {
+            case 0: acc.col(cs) += a * sp; acc.col(cc) += a * cp; break;
+            case 1: acc.col(cs) -= a * cp; acc.col(cc) += a * sp; break;
+            case 2: acc.col(cs) -= a * sp; acc.col(cc) -= a * cp; break;
+            default: acc.col(cs) += a * cp; acc.col(cc) -= a * sp; break;
+          }
+        }
+        scale[g] = a * loads_[g].omega * eta_ / (r + 1);
+      }
+      us[ru + 1] = f * acc;
+    }
+    const auto last = static_cast<std::size_t>(d_ + 1);
+    ps[last] = touching.asDiagonal() * gw[last];
+
+    // bar = T v + Σ_g (sin_g, cos_g responses) + Σ_r correction_r p_r.
+    Matrix bar = Matrix::Zero(2 * n, cols);
+    bar.leftCols(2 * n) = Matrix(transition_);
+    for (std::size_t g = 0; g < harmonics_.size(); ++g) {
+      const Index cs = first_phase + 2 * static_cast<Index>(g);
+      bar.col(cs) += Vector(harmonics_[g].sin_response);
+      bar.col(cs + 1) += Vector(harmonics_[g].cos_response);
+    }
+    for (std::size_t r = 0; r < correction_.size(); ++r) bar += Matrix(correction_[r]) * ps[r];
+
+    auto out = std::make_unique<ModeOps>();
+    // The phase columns in the order of phases_: sin, cos (zero without a load), 1.
+    const auto phase_columns = [&](const Matrix& a) {
+      Matrix b = Matrix::Zero(a.rows(), 3);
+      b.leftCols(2 * groups) = a.middleCols(first_phase, 2 * groups);
+      b.col(2) = a.col(constant);
+      return b;
+    };
+    out->bar = bar.leftCols(2 * n);
+    out->bar_load = phase_columns(bar);
+    for (std::size_t r = 0; r < terms; ++r) {
+      out->gap.push_back(gw[r].leftCols(2 * n));
+      out->gap_load.push_back(phase_columns(gw[r]));
+    }
+    out->touching = touching;
+    out->slope_rows = eta_ * touching.asDiagonal() * W_t;
+
+    // The LCP transform of the mode as active set: x = T_A q with z_A = -M_AA⁻¹ q_A and
+    // w_F = q_F - M_FA M_AA⁻¹ q_A.
+    std::vector<Index> active;
+    for (Index j = 0; j < m; ++j)
+      if (mode_[j] > 0.0) active.push_back(j);
+    const auto k = static_cast<Index>(active.size());
+    const auto at = [&](Index a) { return active[static_cast<std::size_t>(a)]; };
+    Matrix block(k, k);
+    for (Index a = 0; a < k; ++a)
+      for (Index b = 0; b < k; ++b) block(a, b) = lcp_matrix_(at(a), at(b));
+    Matrix inverse = Matrix::Identity(k, k);
+    out->lcp_ready = true;
+    if (k > 0) {
+      const Eigen::FullPivLU<Matrix> lu(block);
+      if (lu.isInvertible()) {
+        inverse = lu.inverse();
+      } else {
+        out->lcp_ready = false;  // the solver reports it
+      }
+    }
+    Matrix transform = Matrix::Zero(m, m);
+    for (Index a = 0; a < k; ++a)
+      for (Index b = 0; b < k; ++b) transform(at(a), at(b)) = -inverse(a, b);
+    for (Index i = 0; i < m; ++i) {
+      if (mode_[i] > 0.0) continue;
+      transform(i, i) = 1.0;
+      for (Index b = 0; b < k; ++b) {
+        double sum = 0.0;
+        for (Index a = 0; a < k; ++a) sum += lcp_matrix_(i, at(a)) * inverse(a, b);
+        transform(i, at(b)) = -sum;
+      }
+    }
+    out->lcp_transform = transform;
+    return out;
+  }
+
+  // The per-mode cache needs fixed sizes (products unrolled, at most 2^6 modes).
+  static constexpr bool kModeCache = Dofs != Eigen::Dynamic && Springs != Eigen::Dynamic;
+  static constexpr Index kMaxCachedSprings = 6;
+  static constexpr long kReanchorSteps = 256;
+  static constexpr double kLcpFeasTol = 1e-11;  // as in lcp_solver.cpp: relative to |q|_inf
 
   SwitchingPimOptions o_;
   Index n_, m_;
@@ -674,6 +982,17 @@ class Stepper final : public SwitchingPim {
   GapSample start_;
   event_detail::SearchSettings settings_;
   std::vector<Index> flip_;
+
+  Matrix lcp_matrix_;
+  double lcp_scale_ = 1.0;       // max |M_ij| of the LCP matrix
+  bool inline_lcp_ = false;      // the solver is block pivoting
+  bool mode_cached_ = false;     // step_cached() is used
+  std::uint64_t mode_mask_ = 0;  // bit j: spring j touching (mode_[j] = 1)
+  std::vector<std::unique_ptr<ModeOps>> mode_ops_;  // by mode_mask_
+  std::vector<Rotation> rotations_;
+  Phases phases_;  // sin ωt, cos ωt of the load group at the step start, and 1
+  Force lcp_x_;
+  Half scaled_velocity_;  // η x'
 };
 
 template <int N>
