@@ -47,12 +47,7 @@ analysis::RegimeMapOptions map_options(const MapFlags& f) {
 
 void map(const MapFlags& f) {
   const analysis::RegimeMapOptions o = map_options(f);
-  Study study;
-  study.description = o.describe();
-  study.tasks = o.tasks();
-  study.chain_of = [o](long id) { return o.chain_of(id); };
-  study.initial_state = o.start_state();
-  study.settings = o.point;
+  Study study = study_of(o);
   study.finish = [&](const std::map<long, analysis::PointResult>& records) {
     analysis::write_map_file(o, records, f.run.out);
     fmt::print("wrote {}/map.csv ({} cells)\n", f.run.out, records.size());

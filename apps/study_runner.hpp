@@ -66,6 +66,19 @@ struct Study {
   std::function<void(const std::map<long, analysis::PointResult>&)> finish;
 };
 
+// The study of a sweep or a map: both option types give its description, tasks, chains, start
+// state and point settings the same way.
+template <class GridOptions>
+Study study_of(const GridOptions& o) {
+  Study study;
+  study.description = o.describe();
+  study.tasks = o.tasks();
+  study.chain_of = [o](long id) { return o.chain_of(id); };
+  study.initial_state = o.start_state();
+  study.settings = o.point;
+  return study;
+}
+
 // Runs the study into flags.out. Throws InputError for a resume that does not match.
 void run_study(const Study& study, const RunFlags& flags);
 

@@ -42,12 +42,7 @@ analysis::SweepOptions sweep_options(const SweepFlags& f) {
 
 void sweep(const SweepFlags& f) {
   const analysis::SweepOptions o = sweep_options(f);
-  Study study;
-  study.description = o.describe();
-  study.tasks = o.tasks();
-  study.chain_of = [o](long id) { return o.chain_of(id); };
-  study.initial_state = o.start_state();
-  study.settings = o.point;
+  Study study = study_of(o);
   study.finish = [&](const std::map<long, analysis::PointResult>& records) {
     analysis::write_sweep_files(o, records, f.run.out);
     fmt::print("wrote {0}/poincare.csv and {0}/classification.csv ({1} points)\n", f.run.out,
