@@ -8,6 +8,7 @@
 
 #include "pwl/banded_propagator.hpp"
 #include "pwl/errors.hpp"
+#include "fixed_step_count.hpp"
 #include "pwl/substructure_exponential.hpp"
 
 namespace pwl {
@@ -92,15 +93,7 @@ class BandedPimIntegrator final : public Integrator {
 
   void advance_to(double t_end, const StepObserver& observer) override {
     const double eta = propagator_.step_size();
-    const double span = (t_end - propagator_.time()) / eta;
-    const double whole = std::round(span);
-    if (!std::isfinite(t_end) || whole < 0.0 || std::abs(span - whole) > 1e-6) {
-      throw InputError(fmt::format(
-          "advance_to(t_end = {}): from t = {} that is {} steps of {}; the precise integrator "
-          "needs a whole, non-negative number of steps",
-          t_end, propagator_.time(), span, eta));
-    }
-    const long count = static_cast<long>(whole);
+    const long count = detail::fixed_step_count(t_end, propagator_.time(), eta);
     for (long k = 0; k < count; ++k) {
       propagator_.step();
       stats_.lcp_pivots += propagator_.last_lcp_pivots();

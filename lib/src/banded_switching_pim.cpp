@@ -17,6 +17,7 @@
 #include "pwl/banded_pim_integrator.hpp"
 #include "pwl/banded_step_operators.hpp"
 #include "pwl/errors.hpp"
+#include "fixed_step_count.hpp"
 #include "pwl/substructure_exponential.hpp"
 #include "switching_pim_detail.hpp"
 
@@ -323,15 +324,7 @@ class BandedStepper final : public SwitchingPim {
   }
 
   void advance_to(double t_end, const StepObserver& observer) override {
-    const double span = (t_end - time()) / eta_;
-    const double whole = std::round(span);
-    if (!std::isfinite(t_end) || whole < 0.0 || std::abs(span - whole) > 1e-6) {
-      throw InputError(fmt::format(
-          "advance_to(t_end = {}): from t = {} that is {} steps of {}; the precise integrator "
-          "needs a whole, non-negative number of steps",
-          t_end, time(), span, eta_));
-    }
-    const long count = static_cast<long>(whole);
+    const long count = detail::fixed_step_count(t_end, time(), eta_);
     for (long k = 0; k < count; ++k) {
       step();
       if (observer) {

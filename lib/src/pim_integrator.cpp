@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "pwl/errors.hpp"
+#include "fixed_step_count.hpp"
 #include "pwl/precise_propagator.hpp"
 
 namespace pwl {
@@ -66,15 +67,7 @@ class PimIntegrator final : public Integrator {
  private:
   void advance(double t_end, Matrix* tangent, const StepObserver& observer) {
     const double eta = propagator_.step_size();
-    const double span = (t_end - propagator_.time()) / eta;
-    const double whole = std::round(span);
-    if (!std::isfinite(t_end) || whole < 0.0 || std::abs(span - whole) > 1e-6) {
-      throw InputError(fmt::format(
-          "advance_to(t_end = {}): from t = {} that is {} steps of {}; the precise integrator "
-          "needs a whole, non-negative number of steps",
-          t_end, propagator_.time(), span, eta));
-    }
-    const long count = static_cast<long>(whole);
+    const long count = detail::fixed_step_count(t_end, propagator_.time(), eta);
     if constexpr (Dofs != Eigen::Dynamic && Dofs == Springs) {
       // One tangent vector on fixed-size storage (λ1 alone): the single-vector map.
       if (tangent != nullptr && tangent->cols() == 1 && tangent->rows() == 2 * Dofs) {

@@ -14,6 +14,7 @@
 #include "event_location.hpp"
 #include "switching_pim_detail.hpp"
 #include "pwl/errors.hpp"
+#include "fixed_step_count.hpp"
 #include "pwl/lcp_solver.hpp"
 #include "pwl/pim_step_operators.hpp"
 
@@ -339,15 +340,7 @@ class Stepper final : public SwitchingPim {
   }
 
   void advance_to(double t_end, const StepObserver& observer) override {
-    const double span = (t_end - time()) / eta_;
-    const double whole = std::round(span);
-    if (!std::isfinite(t_end) || whole < 0.0 || std::abs(span - whole) > 1e-6) {
-      throw InputError(fmt::format(
-          "advance_to(t_end = {}): from t = {} that is {} steps of {}; the precise integrator "
-          "needs a whole, non-negative number of steps",
-          t_end, time(), span, eta_));
-    }
-    const long count = static_cast<long>(whole);
+    const long count = detail::fixed_step_count(t_end, time(), eta_);
     for (long k = 0; k < count; ++k) {
       step();
       if (observer) {
