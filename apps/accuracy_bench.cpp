@@ -249,13 +249,15 @@ void plot(const AccuracyOptions& o, const std::string& stem, const std::vector<C
       keys += (keys.empty() ? "" : " ") + c.key;
     }
   }
-  const std::string out = fmt::format("{}/work_precision_{}.png", o.plots, stem);
-  const std::string definitions =
-      fmt::format("data='{}'; stem='{}'; curves='{}'; out='{}'; plot_title='{}'; ylabel_text='{}'",
-                  o.out, stem, keys, out, title, error_label);
+  const std::string out = fmt::format("{}/work_precision_{}", o.plots, stem);
+  const auto definitions = [&](const std::string& format) {
+    return fmt::format(
+        "data='{}'; stem='{}'; curves='{}'; out='{}.{}'; plot_title={}; ylabel_text={}", o.out,
+        stem, keys, out, format, gnuplot_quoted(title), gnuplot_quoted(error_label));
+  };
   std::string why;
-  if (run_gnuplot(plots_directory() + "/work_precision.gp", definitions, &why)) {
-    fmt::print("wrote {}\n", out);
+  if (draw_figure(plots_directory() + "/work_precision.gp", definitions, &why)) {
+    fmt::print("wrote {}.png and .svg\n", out);
   } else {
     fmt::print(stderr, "pwl bench accuracy: no figure: {}\n", why);
   }

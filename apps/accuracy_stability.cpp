@@ -325,15 +325,18 @@ void stability(StabilityOptions o) {
   fmt::print("CSV files in {}\n", o.out);
 
   if (o.no_plot) return;
-  const std::string out = fmt::format("{}/stability.png", o.plots);
-  const std::string definitions = fmt::format(
-      "data='{}'; out='{}'; target={:g}; periods={}; accuracy_periods={}; plot_title='Stability "
-      "and failure map: 5-DOF chain of figure 4a with α = k_2/k_1 varied; failures over {} "
-      "periods, error over the first {}, against the exact solver'",
-      o.out, out, o.target, o.periods, o.accuracy_periods, o.periods, o.accuracy_periods);
+  const std::string out = fmt::format("{}/stability", o.plots);
+  const auto definitions = [&](const std::string& format) {
+    return fmt::format(
+        "data='{}'; out='{}.{}'; target={:g}; periods={}; accuracy_periods={}; plot_title='"
+        "Stability and failure map: 5-DOF chain of figure 4a with α = k_2/k_1 varied; failures "
+        "over {} periods, error over the first {}, against the exact solver'",
+        o.out, out, format, o.target, o.periods, o.accuracy_periods, o.periods,
+        o.accuracy_periods);
+  };
   std::string why;
-  if (run_gnuplot(plots_directory() + "/stability.gp", definitions, &why)) {
-    fmt::print("wrote {}\n", out);
+  if (draw_figure(plots_directory() + "/stability.gp", definitions, &why)) {
+    fmt::print("wrote {}.png and .svg\n", out);
   } else {
     fmt::print(stderr, "pwl bench stability: no figure: {}\n", why);
   }

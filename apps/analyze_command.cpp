@@ -128,12 +128,15 @@ void analyze(AnalyzeOptions o) {
     std::fclose(f);
   }
   std::string why;
-  const std::string definitions = fmt::format(
-      "trajectory='{0}/trajectory.csv'; poincare='{0}/poincare.csv'; out='{0}/analysis.png'; "
-      "pxcol={1}; pvcol={2}; mass={3}; label='{4}: {5}'",
-      o.out, 1 + mass, 1 + n + mass, mass, o.run.description(), c.name());
-  if (run_gnuplot(plots_directory() + "/analysis_panels.gp", definitions, &why)) {
-    fmt::print("wrote {0}/poincare.csv, {0}/classification.csv, {0}/analysis.png\n", o.out);
+  const auto definitions = [&](const std::string& format) {
+    return fmt::format(
+        "trajectory='{0}/trajectory.csv'; poincare='{0}/poincare.csv'; out='{0}/analysis.{6}'; "
+        "pxcol={1}; pvcol={2}; mass={3}; label='{4}: {5}'",
+        o.out, 1 + mass, 1 + n + mass, mass, o.run.description(), c.name(), format);
+  };
+  if (draw_figure(plots_directory() + "/analysis_panels.gp", definitions, &why)) {
+    fmt::print("wrote {0}/poincare.csv, {0}/classification.csv, {0}/analysis.png and .svg\n",
+               o.out);
   } else {
     fmt::print(stderr, "pwl analyze: no figure: {}\n", why);
   }

@@ -209,11 +209,11 @@ ChainBenchResult run_chain_bench(const ChainBenchOptions& o) {
     std::FILE* f = std::fopen((o.out + "/bench_chain.csv").c_str(), "w");
     if (f == nullptr) throw Error(fmt::format("cannot write {}/bench_chain.csv", o.out));
     fmt::print(f,
-               "method,parameters,runs,wall_median_s,cpu_median_s,setup_median_s,steps,"
+               "key,method,parameters,runs,wall_median_s,cpu_median_s,setup_median_s,steps,"
                "work,error_x1,error_v1,time_vs_banded,error_x1_vs_banded\n");
     for (const ChainMethodResult& r : result.methods) {
-      fmt::print(f, "\"{}\",\"{}\",{},{:.6g},{:.6g},{:.6g},{},{},{:.6e},{:.6e},{:.6g},{:.6g}\n",
-                 r.label, r.parameters, r.runs, r.wall, r.cpu, r.setup, r.steps, r.work,
+      fmt::print(f, "{},\"{}\",\"{}\",{},{:.6g},{:.6g},{:.6g},{},{},{:.6e},{:.6e},{:.6g},{:.6g}\n",
+                 r.key, r.label, r.parameters, r.runs, r.wall, r.cpu, r.setup, r.steps, r.work,
                  r.error_x, r.error_v, base ? r.wall / base->wall : 0.0,
                  base ? r.error_x / base->error_x : 0.0);
     }

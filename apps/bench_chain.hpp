@@ -27,6 +27,7 @@ struct ChainBenchOptions {
   // Which methods to run (keys of chain_bench_methods()); empty: all.
   std::vector<std::string> methods;
   std::string out = "out/bench";      // CSV files and the cached reference
+  bool figures = false;               // also draw the paper's figures 7-9 (chain_figures.hpp)
   bool quiet = false;
 };
 

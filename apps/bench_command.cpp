@@ -5,6 +5,7 @@
 //   pwl bench stability  where each method breaks as the contacts stiffen (accuracy_bench.hpp)
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -13,6 +14,8 @@
 #include "bench_chain.hpp"
 #include "bench_scaling.hpp"
 #include "bench_sweep.hpp"
+#include "chain_figures.hpp"
+#include "pwl/errors.hpp"
 #include "commands.hpp"
 
 namespace pwl::app {
@@ -24,7 +27,8 @@ void add_chain(CLI::App& bench) {
       "chain",
       "The paper's Table 1: its section 4.2 chain (n = 1000, t in [0, 200] s) by the banded PIM,\n"
       "the dense PIM and dopri5, with the largest error of x1 and x1' against a reference\n"
-      "Example: pwl bench chain --out out/bench");
+      "Example: pwl bench chain --out out/bench\n"
+      "         pwl run apps/scenes/paper_fig7-9_table1.toml   (the paper's methods, figures 7-9)");
   c->add_option("--n", o->masses, "Number of masses")->check(CLI::Range(2, 100000000));
   c->add_option("--t-end", o->t_end, "End of the run (s)")->check(CLI::PositiveNumber);
   c->add_option("--runs", o->runs, "Timed runs per method (median)")->check(CLI::PositiveNumber);
@@ -47,8 +51,16 @@ void add_chain(CLI::App& bench) {
                 "dopri5-1e-5-kinks, dopri5-1e-10-kinks")
       ->delimiter(',');
   c->add_option("--out", o->out, "Folder for bench_chain.csv and the cached reference");
+  c->add_flag("--figures", o->figures,
+              "Also draw the paper's figures 7-9 into --out (needs pim-banded and dopri5-1e-5)");
   c->add_flag("--quiet", o->quiet, "Print only the table");
   c->callback([o] {
+    if (o->figures && !o->methods.empty()) {
+      for (const char* needed : {"pim-banded", "dopri5-1e-5"}) {
+        if (std::find(o->methods.begin(), o->methods.end(), needed) == o->methods.end())
+          throw InputError(fmt::format("--figures needs {} in --methods", needed));
+      }
+    }
     const ChainBenchResult r = run_chain_bench(*o);
     const std::string table = format_chain_table(r);
     fmt::print("{}", table);
@@ -57,6 +69,14 @@ void add_chain(CLI::App& bench) {
       std::fclose(f);
     }
     fmt::print("\nwrote {0}/bench_chain.csv and {0}/bench_chain.md\n", o->out);
+    std::string why;
+    if (o->figures) {
+      if (draw_chain_figures(r, o->out, &why)) {
+        fmt::print("wrote {0}/fig7.png, {0}/fig8.png, {0}/fig9.png and their .svg\n", o->out);
+      } else {
+        fmt::print(stderr, "pwl bench chain: figures 7-9 not drawn: {}\n", why);
+      }
+    }
   });
 }
 

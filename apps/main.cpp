@@ -24,9 +24,7 @@ int main(int argc, char** argv) {
   pwl::app::add_sweep_command(app);
   pwl::app::add_map_command(app);
   pwl::app::add_run_command(app);
-  for (const char* job : {"simulate", "analyze", "sweep", "map"}) {
-    pwl::app::add_scene_options(*app.get_subcommand(job));
-  }
+  pwl::app::add_scene_options(app);
   pwl::app::ExpandedCommandLine line;
   try {
     line = pwl::app::expand_scenes(std::vector<std::string>(argv + 1, argv + argc), app);

@@ -56,13 +56,15 @@ void map(const MapFlags& f) {
     const double dx = o.first.points > 1 ? (o.first.to - o.first.from) / (o.first.points - 1) : 1.0;
     const double dy =
         o.second.points > 1 ? (o.second.to - o.second.from) / (o.second.points - 1) : 1.0;
-    const std::string definitions = fmt::format(
-        "data='{0}/map.csv'; out='{0}/regime_map.png'; out_lambda='{0}/lambda1_map.png'; "
-        "xname='{1}'; yname='{2}'; dx={3:.17g}; dy={4:.17g}; subtitle='{5}'",
-        f.run.out, parameter_label(o.first.parameter), parameter_label(o.second.parameter), dx, dy,
-        study_title(o.chain, o.point));
-    if (run_gnuplot(plots_directory() + "/regime_map.gp", definitions, &why)) {
-      fmt::print("wrote {0}/regime_map.png and {0}/lambda1_map.png\n", f.run.out);
+    const auto definitions = [&](const std::string& format) {
+      return fmt::format(
+          "data='{0}/map.csv'; out='{0}/regime_map.{6}'; out_lambda='{0}/lambda1_map.{6}'; "
+          "xname='{1}'; yname='{2}'; dx={3:.17g}; dy={4:.17g}; subtitle={5}",
+          f.run.out, parameter_label(o.first.parameter), parameter_label(o.second.parameter), dx,
+          dy, gnuplot_quoted(study_title(o.chain, o.point)), format);
+    };
+    if (draw_figure(plots_directory() + "/regime_map.gp", definitions, &why)) {
+      fmt::print("wrote {0}/regime_map.png, {0}/lambda1_map.png and their .svg\n", f.run.out);
     } else {
       fmt::print(stderr, "pwl map: no figure: {}\n", why);
     }

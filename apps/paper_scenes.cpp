@@ -5,7 +5,6 @@
 #include <array>
 #include <cstdio>
 #include <cstdlib>
-#include <filesystem>
 #include <memory>
 
 #include "pwl/errors.hpp"
@@ -27,15 +26,11 @@ std::string capture(const std::string& command) {
   return out;
 }
 
-// The rest of the line after `prefix` in `text` ("" when absent).
-std::string line_after(const std::string& text, const std::string& prefix) {
-  const std::size_t at = text.find(prefix);
-  if (at == std::string::npos) return "";
-  const std::size_t from = at + prefix.size();
-  return text.substr(from, text.find('\n', from) - from);
+std::string shell_quoted(const std::string& s) {
+  std::string quoted = "'";
+  for (char c : s) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return quoted + "'";
 }
-
-std::string shell_quoted(const std::string& s) { return fmt::format("'{}'", s); }
 
 }  // namespace
 
@@ -44,38 +39,48 @@ std::string scenes_directory() {
   return PWL_SCENES_DIR;
 }
 
-std::vector<SceneRegime> run_paper_scenes(const std::string& self, const std::string& plots_dir,
-                                          bool quick) {
-  // SPEC.md §5: the paper's captions.
-  const std::vector<std::pair<std::string, std::string>> cases{{"5", "chaotic"},
-                                                               {"6", "quasi-periodic"}};
-  std::vector<SceneRegime> results;
-  for (const auto& [figure, paper] : cases) {
-    SceneRegime r;
-    r.figure = figure;
-    r.paper_regime = paper;
-    r.scene = fmt::format("{}/paper_fig{}.toml", scenes_directory(), figure);
-    const std::string out = fmt::format("{}/data/scene_fig{}", plots_dir, figure);
-    std::string command = fmt::format("{} run {} --set output.out={}", shell_quoted(self),
-                                      shell_quoted(r.scene), shell_quoted(out));
-    if (quick) command += " --set run.periods=400 --set analysis.transient=250";
-    fmt::print("figure {}: pwl run {}\n", figure, r.scene);
-    std::fflush(stdout);
-    const std::string printed = capture(command);
-    r.regime = line_after(printed, "regime: ");
-    r.lambda1 = line_after(printed, "lambda1: ");
-    r.zero_one = line_after(printed, "0-1 test: ");
-    if (r.regime.empty()) throw Error(fmt::format("{} printed no regime:\n{}", command, printed));
-    fmt::print("  the paper says {}, pwl finds {} (λ1 {}; {})\n", paper, r.regime, r.lambda1,
-               r.zero_one);
-    if (!quick) {
-      std::filesystem::copy_file(out + "/analysis.png",
-                                 fmt::format("{}/analysis_fig{}.png", plots_dir, figure),
-                                 std::filesystem::copy_options::overwrite_existing);
-    }
-    results.push_back(r);
+std::string line_after(const std::string& text, const std::string& prefix) {
+  const std::size_t at = text.find(prefix);
+  if (at == std::string::npos) return "";
+  const std::size_t from = at + prefix.size();
+  return text.substr(from, text.find('\n', from) - from);
+}
+
+const std::vector<ReproducedScene>& reproduced_scenes() {
+  static const std::vector<ReproducedScene> scenes{
+      {"4a", "paper_fig4a.toml", {"run.periods=300", "run.skip_periods=200"},
+       {{"comparison", "fig4a"}}},
+      {"4b", "paper_fig4b.toml", {"run.periods=300", "run.skip_periods=200"},
+       {{"comparison", "fig4b"}}},
+      {"5", "paper_fig5.toml", {"run.periods=400", "analysis.transient=250"},
+       {{"analysis", "analysis_fig5"}}},
+      {"6", "paper_fig6.toml", {"run.periods=400", "analysis.transient=250"},
+       {{"analysis", "analysis_fig6"}}},
+      {"7-9",
+       "paper_fig7-9_table1.toml",
+       {"structure.masses=200", "method.reference_tol=1e-10", "run.runs=1"},
+       {{"fig7", "fig7"}, {"fig8", "fig8"}, {"fig9", "fig9"}}},
+      {"theta-sweep",
+       "theta_sweep.toml",
+       {"sweep.points=12", "run.transient=50", "run.periods=100"},
+       {{"bifurcation", "bifurcation_theta"}}},
+      {"theta-alpha-map",
+       "theta_alpha_map.toml",
+       {"map.x_points=5", "map.y_points=4", "run.transient=50", "run.periods=100"},
+       {{"regime_map", "regime_map_theta_alpha"}, {"lambda1_map", "lambda1_map_theta_alpha"}}},
+  };
+  return scenes;
+}
+
+std::string run_scene(const std::string& self, const ReproducedScene& scene,
+                      const std::string& out, bool quick) {
+  std::string command =
+      fmt::format("{} run {} --set output.out={}", shell_quoted(self),
+                  shell_quoted(scenes_directory() + "/" + scene.scene), shell_quoted(out));
+  if (quick) {
+    for (const std::string& s : scene.quick) command += " --set " + shell_quoted(s);
   }
-  return results;
+  return capture(command);
 }
 
 }  // namespace pwl::app

@@ -1,8 +1,9 @@
 #pragma once
-// The shipped scenes of the paper's figures 5 and 6 (apps/scenes/paper_fig5.toml,
-// paper_fig6.toml), run as a user would run them (`pwl run SCENE`), for `pwl reproduce`: the
-// regime pwl finds next to the one the paper states.
+// The shipped scenes that `pwl reproduce` runs, each as a user would run it (`pwl run SCENE`), and
+// where each puts the figures the README shows. A scene's own output goes under
+// <plots>/data/<scene>; its figures are copied to <plots>/<name>.png and .svg.
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace pwl::app {
@@ -10,19 +11,25 @@ namespace pwl::app {
 // The folder of the shipped scenes: $PWL_SCENES_DIR, else apps/scenes of the source tree.
 std::string scenes_directory();
 
-struct SceneRegime {
-  std::string figure;        // "5"
-  std::string scene;         // the scene file
-  std::string paper_regime;  // what the paper says
-  std::string regime;        // what pwl finds
-  std::string lambda1;       // the λ1 line of pwl analyze
-  std::string zero_one;      // the K line
+struct ReproducedScene {
+  std::string key;    // for --only: "4a", "4b", "5", "6", "7-9", "theta-sweep", "theta-alpha-map"
+  std::string scene;  // file name in the scenes folder
+  // --set overrides of a smoke run (--quick): shorter runs, smaller grids.
+  std::vector<std::string> quick;
+  // (file written by the scene, name of the figure under plots/), without the extension.
+  std::vector<std::pair<std::string, std::string>> figures;
 };
 
-// Runs each paper scene of an analyze job through this very program (`self`: its path), its
-// output under data_dir/<scene name>. quick: 400 periods, 250 of them transient. Copies the
-// two-panel figure to plots_dir/analysis_fig<F>.png unless quick. Throws Error when a run fails.
-std::vector<SceneRegime> run_paper_scenes(const std::string& self, const std::string& plots_dir,
-                                          bool quick);
+// Every scene `pwl reproduce` runs, in order: the paper's figures and table, then the project's
+// own charts that need no timing (the benchmarks' charts are made by their bench_*.toml scenes).
+const std::vector<ReproducedScene>& reproduced_scenes();
+
+// Runs `scene` through this very program (`self`: its path), its output under `out`, with the
+// quick overrides when asked. Returns what it printed; throws Error when the run fails.
+std::string run_scene(const std::string& self, const ReproducedScene& scene,
+                      const std::string& out, bool quick);
+
+// The rest of the line after `prefix` in `text` ("" when absent).
+std::string line_after(const std::string& text, const std::string& prefix);
 
 }  // namespace pwl::app

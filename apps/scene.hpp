@@ -2,7 +2,7 @@
 // Scene files: one TOML file describes a whole study, so that it can be kept, shared, edited and
 // rerun. A scene names its job and groups its settings by what they are about:
 //
-//     job = "analyze"              # simulate | analyze | sweep | map
+//     job = "analyze"              # simulate | analyze | sweep | map | bench chain | ...
 //     [structure]                  # the paper's nondimensional chain ...
 //     figure = "4b"                #   a preset, then any of masses, alpha, zeta, gap, gaps,
 //     theta = 1.0                  #   theta, loads

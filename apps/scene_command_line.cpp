@@ -50,7 +50,7 @@ void check_setting(const SceneSetting& s, const CLI::App& job) {
     throw InputError(fmt::format("{}: {}: pwl {} has no setting {} (its settings: {})", s.where,
                                  s.key, job.get_name(), s.flag, fmt::join(known, ", ")));
   }
-  const bool is_switch = option->get_type_size_max() == 0;
+  const bool is_switch = option->get_expected_max() == 0;  // a flag expects no value
   const bool many = option->get_items_expected_max() > 1;
   const std::string type = option->get_type_name();
   std::string expected;
@@ -77,7 +77,60 @@ void check_setting(const SceneSetting& s, const CLI::App& job) {
   }
 }
 
+std::vector<std::string> job_words(const std::string& job) {
+  std::vector<std::string> words;
+  std::size_t from = 0;
+  while (from < job.size()) {
+    const std::size_t end = std::min(job.find(' ', from), job.size());
+    if (end > from) words.push_back(job.substr(from, end - from));
+    from = end + 1;
+  }
+  return words;
+}
+
+// The subcommand that runs `job` ("simulate", "bench chain"), or nullptr: a job is a subcommand
+// without subcommands of its own, and neither `run` nor `reproduce` (they run scenes).
+const CLI::App* find_job(const CLI::App& app, const std::string& job) {
+  const CLI::App* at = &app;
+  for (const std::string& word : job_words(job)) {
+    const CLI::App* next = nullptr;
+    for (const CLI::App* sub : at->get_subcommands({})) {
+      if (sub->get_name() == word) next = sub;
+    }
+    if (next == nullptr) return nullptr;
+    at = next;
+  }
+  if (at == &app || !at->get_subcommands({}).empty()) return nullptr;
+  if (at->get_name() == "run" || at->get_name() == "reproduce") return nullptr;
+  return at;
+}
+
+// Consumed by expand_scenes before parsing; declared for --help.
+void add_scene_options_to(CLI::App& job) {
+  static std::string unused_path;
+  static std::vector<std::string> unused_overrides;
+  job.add_option("--scene", unused_path,
+                 "Take the settings from this scene file (TOML); typed flags win")
+      ->group("Scene");
+  job.add_option("--set", unused_overrides,
+                 "Override one scene setting: key=value, e.g. structure.theta=1.3")
+      ->group("Scene");
+}
+
 }  // namespace
+
+std::vector<std::string> job_names(const CLI::App& app) {
+  std::vector<std::string> names;
+  for (const CLI::App* sub : app.get_subcommands({})) {
+    const std::vector<const CLI::App*> leaves = sub->get_subcommands({});
+    if (leaves.empty()) {
+      if (find_job(app, sub->get_name()) != nullptr) names.push_back(sub->get_name());
+    } else {
+      for (const CLI::App* leaf : leaves) names.push_back(sub->get_name() + " " + leaf->get_name());
+    }
+  }
+  return names;
+}
 
 ExpandedCommandLine expand_scenes(const std::vector<std::string>& args, const CLI::App& app) {
   ExpandedCommandLine out;
@@ -87,7 +140,10 @@ ExpandedCommandLine expand_scenes(const std::vector<std::string>& args, const CL
   std::vector<std::string> overrides;
   std::vector<std::string> rest;  // what the user typed, without the scene's own flags
   std::size_t i = 1;
-  if (args[0] == "run") {
+  if (args[0] == "bench" && args.size() > 1 && args[1].rfind("-", 0) != 0) {
+    job = "bench " + args[1];  // a benchmark is a job of its own: "bench chain"
+    i = 2;
+  } else if (args[0] == "run") {
     if (args.size() < 2 || args[1].rfind("-", 0) == 0) {
       out.args = args;  // `pwl run --help` and the like: the parser explains
       return out;
@@ -126,20 +182,17 @@ ExpandedCommandLine expand_scenes(const std::vector<std::string>& args, const CL
       throw InputError(fmt::format(
           "{}: job: the scene does not say which job it is (job = \"simulate\", ...)", path));
   }
-  const CLI::App* sub = nullptr;
-  try {
-    sub = app.get_subcommand(job);
-  } catch (const CLI::OptionNotFound&) {
-  }
-  if (sub == nullptr || job == "run") {
-    throw InputError(fmt::format("{}: job = \"{}\": not a job of pwl", path, job));
+  const CLI::App* sub = find_job(app, job);
+  if (sub == nullptr) {
+    throw InputError(fmt::format("{}: job = \"{}\": not a job of pwl (expected {})", path, job,
+                                 fmt::join(job_names(app), ", ")));
   }
   std::vector<std::string> typed;
   for (const std::string& a : rest) {
     const std::string f = flag_of_token(a);
     if (!f.empty()) typed.push_back(f);
   }
-  out.args.push_back(job);
+  for (const std::string& word : job_words(job)) out.args.push_back(word);
   Scene kept = scene;
   kept.settings.clear();
   for (const SceneSetting& s : scene.settings) {
@@ -171,24 +224,22 @@ std::string locate_in_scene(const std::string& message, const ExpandedCommandLin
   return message;
 }
 
-void add_scene_options(CLI::App& job) {
-  // Consumed by expand_scenes before parsing; declared here for --help.
-  static std::string unused_path;
-  static std::vector<std::string> unused_overrides;
-  job.add_option("--scene", unused_path,
-                 "Take the settings from this scene file (TOML); typed flags win")
-      ->group("Scene");
-  job.add_option("--set", unused_overrides,
-                 "Override one scene setting: key=value, e.g. structure.theta=1.3")
-      ->group("Scene");
+void add_scene_options(CLI::App& app) {
+  for (const std::string& name : job_names(app)) {
+    CLI::App* job = &app;
+    for (const std::string& word : job_words(name)) job = job->get_subcommand(word);
+    add_scene_options_to(*job);
+  }
 }
+
 
 void add_run_command(CLI::App& app) {
   static std::string unused_path;
   static std::vector<std::string> unused_overrides;
   CLI::App* c =
       app.add_subcommand("run",
-                         "Run the job a scene file describes (simulate, analyze, sweep or map)\n"
+                         "Run the job a scene file describes (simulate, analyze, sweep, map or a\n"
+                         "benchmark)\n"
                          "Example: pwl run apps/scenes/paper_fig4b.toml --set structure.theta=1.1");
   c->add_option("scene", unused_path, "The scene file")->required();
   c->add_option("--set", unused_overrides, "Override one scene setting: key=value");

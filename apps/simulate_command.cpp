@@ -2,6 +2,7 @@
 // the requested masses, and a phase portrait.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <memory>
 
@@ -9,6 +10,7 @@
 #include "commands.hpp"
 #include "csv_writer.hpp"
 #include "gnuplot.hpp"
+#include "method_comparison.hpp"
 #include "pwl/errors.hpp"
 
 namespace pwl::app {
@@ -16,71 +18,83 @@ namespace {
 
 struct SimulateOptions {
   CaseOptions run;
-  std::vector<int> record{};
-  std::string out = "out";
-  bool quiet = false;
+  RecordingOptions output;
+  ComparisonOptions compare;
 };
 
-void simulate(const SimulateOptions& o) {
-  const GapStructure structure = o.run.structure();
+void simulate(const SimulateOptions& options) {
+  const GapStructure structure = options.run.structure();
   const Index n = structure.dofs();
-  for (int r : o.record) {
+  for (int r : options.output.record) {
     if (r < 1 || r > n) {
       throw InputError(fmt::format("--record {}: masses are numbered 1..{}", r, n));
     }
   }
-  if (o.run.skip_periods >= o.run.periods) {
+  if (options.run.skip_periods >= options.run.periods) {
     throw InputError(fmt::format("--skip-periods = {} leaves nothing of --periods = {}",
-                                 o.run.skip_periods, o.run.periods));
+                                 options.run.skip_periods, options.run.periods));
   }
-  const double period = o.run.period();
-  auto integrator = o.run.integrator(structure, period);
-  std::filesystem::create_directories(o.out);
+  if (!options.compare.method.empty()) {
+    simulate_with_comparison(options.run, options.compare, options.output);
+    return;
+  }
+  const CaseOptions& run = options.run;
+  const RecordingOptions& output = options.output;
+  const double period = run.period();
+  auto integrator = run.integrator(structure, period);
+  std::filesystem::create_directories(output.out);
 
-  CsvWriter poincare(o.out + "/poincare.csv", state_columns("t", n));
+  CsvWriter poincare(output.out + "/poincare.csv", state_columns("t", n));
   std::unique_ptr<CsvWriter> trajectory;
-  if (!o.record.empty()) {
+  if (!output.record.empty()) {
     std::vector<std::string> columns{"t"};
-    for (int r : o.record) columns.push_back(fmt::format("x{}", r));
-    for (int r : o.record) columns.push_back(fmt::format("v{}", r));
-    trajectory = std::make_unique<CsvWriter>(o.out + "/trajectory.csv", columns);
+    for (int r : output.record) columns.push_back(fmt::format("x{}", r));
+    for (int r : output.record) columns.push_back(fmt::format("v{}", r));
+    trajectory = std::make_unique<CsvWriter>(output.out + "/trajectory.csv", columns);
   }
-  std::vector<double> row(1 + 2 * o.record.size());
+  std::vector<double> row(1 + 2 * output.record.size());
   const StepObserver record = [&](double t, const Vector& x, const Vector& v) {
     row[0] = t;
-    for (std::size_t j = 0; j < o.record.size(); ++j) {
-      row[1 + j] = x[o.record[j] - 1];
-      row[1 + o.record.size() + j] = v[o.record[j] - 1];
+    for (std::size_t j = 0; j < output.record.size(); ++j) {
+      row[1 + j] = x[output.record[j] - 1];
+      row[1 + output.record.size() + j] = v[output.record[j] - 1];
     }
     trajectory->row(row);
   };
-  if (o.run.skip_periods == 0) poincare.row(0.0, integrator->position(), integrator->velocity());
-  for (int k = 1; k <= o.run.periods; ++k) {
-    const bool keep = k > o.run.skip_periods;
-    integrator->advance_to(k * period, keep && trajectory ? record : StepObserver());
+  if (run.skip_periods == 0) poincare.row(0.0, integrator->position(), integrator->velocity());
+  const int drawn_from =
+      output.trajectory_periods > 0
+          ? std::max(run.skip_periods, run.periods - output.trajectory_periods)
+          : run.skip_periods;
+  for (int k = 1; k <= run.periods; ++k) {
+    const bool keep = k > run.skip_periods;
+    integrator->advance_to(k * period, k > drawn_from && trajectory ? record : StepObserver());
     if (keep) poincare.row(integrator->time(), integrator->position(), integrator->velocity());
   }
   const IntegratorStats s = integrator->stats();
-  if (!o.quiet) {
+  if (!output.quiet) {
     fmt::print("{}: {} periods, {} steps, {} rejected, {} kink events, {} LCP pivots\n",
-               integrator->name(), o.run.periods, s.steps, s.rejected_steps, s.kink_events,
+               integrator->name(), run.periods, s.steps, s.rejected_steps, s.kink_events,
                s.lcp_pivots);
-    fmt::print("wrote {}/poincare.csv{}\n", o.out, trajectory ? " and trajectory.csv" : "");
+    fmt::print("wrote {}/poincare.csv{}\n", output.out, trajectory ? " and trajectory.csv" : "");
   }
   if (trajectory) {
     trajectory.reset();
-    const int mass = o.record.front();
+    const int mass = output.record.front();
+    const auto definitions = [&](const std::string& format) {
+      return fmt::format(
+          "trajectory='{0}/trajectory.csv'; poincare='{0}/poincare.csv'; out='{0}/phase.{10}'; "
+          "xcol={1}; vcol={2}; pxcol={3}; pvcol={4}; mass={5}; title={11}; "
+          "label='{6}, {7}, {8} periods after {9}'",
+          output.out, 2, 2 + output.record.size(), 1 + mass, 1 + n + mass, mass,
+          integrator->name(), run.description(), run.periods - run.skip_periods, run.skip_periods,
+          format, gnuplot_quoted(output.title));
+    };
     std::string why;
-    const std::string definitions = fmt::format(
-        "trajectory='{0}/trajectory.csv'; poincare='{0}/poincare.csv'; out='{0}/phase.png'; "
-        "xcol={1}; vcol={2}; pxcol={3}; pvcol={4}; mass={5}; "
-        "label='{6}, {7}, {8} periods after {9}'",
-        o.out, 2, 2 + o.record.size(), 1 + mass, 1 + n + mass, mass, integrator->name(),
-        o.run.description(), o.run.periods - o.run.skip_periods, o.run.skip_periods);
-    if (run_gnuplot(plots_directory() + "/phase_portrait.gp", definitions, &why)) {
-      if (!o.quiet) fmt::print("wrote {}/phase.png\n", o.out);
-    } else {
+    if (!draw_figure(plots_directory() + "/phase_portrait.gp", definitions, &why)) {
       fmt::print(stderr, "pwl simulate: no figure: {}\n", why);
+    } else if (!output.quiet) {
+      fmt::print("wrote {}/phase.png and .svg\n", output.out);
     }
   }
 }
@@ -92,12 +106,28 @@ void add_simulate_command(CLI::App& app) {
   CLI::App* c = app.add_subcommand(
       "simulate",
       "Integrate one case of the nondimensional chain and write its Poincaré points\n"
-      "Example: pwl simulate --figure 4a --periods 1000 --skip-periods 500 --record 5 --out fig4a");
+      "Example: pwl simulate --figure 4a --periods 1000 --skip-periods 500 --record 5 --out fig4a\n"
+      "         pwl simulate --figure 4a --record 5 --compare-with dopri5 --compare-tol 1e-10\n"
+      "                      --compare-locate-kinks --out fig4a_checked");
   add_case_options(*c, options->run);
-  c->add_option("--record", options->record, "Masses (1-based) whose trajectory to write")
+  RecordingOptions& output = options->output;
+  c->add_option("--record", output.record, "Masses (1-based) whose trajectory to write")
       ->delimiter(',');
-  c->add_option("--out", options->out, "Output folder");
-  c->add_flag("--quiet", options->quiet, "Print nothing on success");
+  c->add_option("--trajectory-periods", output.trajectory_periods,
+                "Write the trajectory of only the last N periods (0: every kept period)")
+      ->check(CLI::NonNegativeNumber);
+  c->add_option("--title", output.title, "Title of the figure");
+  c->add_option("--compare-with", options->compare.method,
+                "Integrate the case again by this method, on the same time grid, and compare")
+      ->check(CLI::IsMember({"pim", "pim-dense", "pim-banded", "pim-switching",
+                             "pim-switching-banded", "exact", "dopri5", "rkf78"}));
+  c->add_option("--compare-tol", options->compare.tolerance,
+                "Tolerance of the compared method (dopri5/rkf78)")
+      ->check(CLI::PositiveNumber);
+  c->add_flag("--compare-locate-kinks", options->compare.locate_kinks,
+              "The compared dopri5/rkf78 ends a step at every spring switch");
+  c->add_option("--out", output.out, "Output folder");
+  c->add_flag("--quiet", output.quiet, "Print nothing on success");
   c->callback([options] { simulate(*options); });
 }
 

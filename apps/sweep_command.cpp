@@ -2,7 +2,13 @@
 // bifurcation diagram (see analysis/include/pwl/analysis/parameter_sweep.hpp).
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
 #include <memory>
+#include <set>
 
 #include "commands.hpp"
 #include "gnuplot.hpp"
@@ -40,6 +46,37 @@ analysis::SweepOptions sweep_options(const SweepFlags& f) {
   return o;
 }
 
+// What the bifurcation diagram draws: the first recorded component of every Poincaré point,
+// with the points of one parameter value and direction that fall within 1/1000 of the plotted
+// range of each other (under a pixel) kept once (a periodic orbit's hundreds of returns are a few points), so
+// that the SVG stays small. Same columns as poincare.csv, one component.
+void write_plotted_points(const analysis::SweepOptions& o,
+                          const std::map<long, analysis::PointResult>& records,
+                          const std::string& path) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const auto& [id, r] : records) {
+    for (int k = 0; k < r.rows(); ++k) {
+      const double y = r.poincare[static_cast<std::size_t>(k) * static_cast<std::size_t>(r.columns)];
+      if (std::isfinite(y)) lo = std::min(lo, y), hi = std::max(hi, y);
+    }
+  }
+  const double cell = hi > lo ? (hi - lo) / 1000.0 : 1.0;
+  std::FILE* file = std::fopen(path.c_str(), "w");
+  if (file == nullptr) throw Error(fmt::format("cannot write {}", path));
+  fmt::print(file, "{},direction,index,period_index,value\n", analysis::parameter_name(o.parameter));
+  for (const auto& [id, r] : records) {
+    const int index = static_cast<int>(id % o.points);
+    std::set<long long> seen;
+    for (int k = 0; k < r.rows(); ++k) {
+      const double y = r.poincare[static_cast<std::size_t>(k) * static_cast<std::size_t>(r.columns)];
+      if (!std::isfinite(y) || !seen.insert(std::llround((y - lo) / cell)).second) continue;
+      fmt::print(file, "{:.17g},{},{},{},{:.17g}\n", o.value(index), id < o.points ? "up" : "down",
+                 index, o.point.transient_periods + k + 1, y);
+    }
+  }
+  if (std::fclose(file) != 0) throw Error(fmt::format("cannot finish writing {}", path));
+}
+
 void sweep(const SweepFlags& f) {
   const analysis::SweepOptions o = sweep_options(f);
   Study study = study_of(o);
@@ -48,19 +85,25 @@ void sweep(const SweepFlags& f) {
     fmt::print("wrote {0}/poincare.csv and {0}/classification.csv ({1} points)\n", f.run.out,
                records.size());
     if (f.run.no_plot) return;
+    write_plotted_points(o, records, f.run.out + "/bifurcation_points.csv");
     std::string why;
-    const std::string definitions = fmt::format(
-        "poincare='{0}/poincare.csv'; classes='{0}/classification.csv'; out='{0}/bifurcation.png'; "
-        "column=5; xname='{1}'; yname='{2} at t = kT (nondimensional)'; title='{3}'",
-        f.run.out, parameter_label(o.parameter),
-        o.point.components.empty() ? std::string("x")
-                                   : analysis::component_name(o.point.components[0],
-                                                              o.chain.masses),
-        fmt::format("pwl sweep of {} ({}): {}", analysis::parameter_name(o.parameter),
-                    o.mode == analysis::SweepMode::continuation ? "continuation" : "independent",
-                    study_title(o.chain, o.point)));
-    if (run_gnuplot(plots_directory() + "/bifurcation.gp", definitions, &why)) {
-      fmt::print("wrote {}/bifurcation.png\n", f.run.out);
+    const auto definitions = [&](const std::string& format) {
+      return fmt::format(
+          "poincare='{0}/bifurcation_points.csv'; classes='{0}/classification.csv'; "
+          "out='{0}/bifurcation.{4}'; column=5; xname='{1}'; "
+          "yname='{2} at t = kT (nondimensional)'; title={3}",
+          f.run.out, parameter_label(o.parameter),
+          o.point.components.empty()
+              ? std::string("x")
+              : analysis::component_name(o.point.components[0], o.chain.masses),
+          gnuplot_quoted(fmt::format(
+              "pwl sweep of {} ({}): {}", analysis::parameter_name(o.parameter),
+              o.mode == analysis::SweepMode::continuation ? "continuation" : "independent",
+              study_title(o.chain, o.point))),
+          format);
+    };
+    if (draw_figure(plots_directory() + "/bifurcation.gp", definitions, &why)) {
+      fmt::print("wrote {}/bifurcation.png and .svg\n", f.run.out);
     } else {
       fmt::print(stderr, "pwl sweep: no figure: {}\n", why);
     }

@@ -1,8 +1,7 @@
 # Two panels like the paper's figures 4-6: the phase portrait of one mass (left) and its
 # stroboscopic Poincaré map (right), for `pwl analyze`.
 # Variables (gnuplot -e): trajectory, poincare, out, pxcol, pvcol, mass, label.
-set terminal pngcairo size 1400,620 enhanced font 'DejaVu Sans,11'
-set output out
+call 'terminal.gp' 1400 620 11
 set datafile separator ','
 set multiplot layout 1,2 title label font ',13'
 set grid lc rgb '#dddddd'

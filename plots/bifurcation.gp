@@ -1,8 +1,9 @@
 # Bifurcation diagram of a parameter sweep (pwl sweep): the Poincaré points of one state
 # component against the swept parameter, the upward and downward continuation branches in two
 # colours, and below them a strip coloured by the regime of every point.
-# Variables (gnuplot -e): poincare, classes (CSV files of pwl sweep), out (PNG), column (the
-# column of poincare.csv to draw, 5 = the first recorded component), xname, yname, title.
+# Variables (gnuplot -e): poincare (bifurcation_points.csv or poincare.csv of pwl sweep), classes
+# (classification.csv), out, fmt, column (the
+# column to draw, 5 = the first recorded component), xname, yname, title.
 if (!exists("poincare")) poincare = 'plots/data/theta_sweep/poincare.csv'
 if (!exists("classes")) classes = 'plots/data/theta_sweep/classification.csv'
 if (!exists("out")) out = 'plots/bifurcation.png'
@@ -11,8 +12,7 @@ if (!exists("xname")) xname = 'theta'
 if (!exists("yname")) yname = 'x5'
 if (!exists("title")) title = ''
 set datafile separator ','
-set terminal pngcairo size 1400,900 font 'DejaVu Sans,12'
-set output out
+call 'terminal.gp' 1400 900 12
 # Regime codes (sweep_point.hpp): 1..8 period-k, 9 longer period, 10 quasi-periodic, 11 chaotic,
 # 12 unbounded, 13 uncertain.
 color(c) = c == 1 ? 0x1f77b4 : c == 2 ? 0x2ca02c : c == 3 ? 0x17becf : c == 4 ? 0x9467bd : \

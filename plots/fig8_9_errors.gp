@@ -2,8 +2,7 @@
 # run of the 1000-mass chain. Two panels: (a) displacement, (b) velocity.
 # Variables (gnuplot -e): data (CSV t,error_x1,error_v1), out (PNG), fig (8 or 9), method,
 # params (the chain), reference, ex and ev (largest errors, as text).
-set terminal pngcairo size 1000,900 enhanced font 'DejaVu Sans,11'
-set output out
+call 'terminal.gp' 1000 900 11
 set datafile separator ','
 set grid lc rgb '#dddddd'
 set key top left opaque box

@@ -1,11 +1,12 @@
 # Phase portrait of one mass with its stroboscopic Poincaré points, for `pwl simulate --record`.
-# Variables (gnuplot -e): trajectory, poincare, out, xcol, vcol, pxcol, pvcol, mass, label.
-set terminal pngcairo size 900,700 enhanced font 'DejaVu Sans,11'
-set output out
+# Variables (gnuplot -e): trajectory, poincare, out, fmt, xcol, vcol, pxcol, pvcol, mass, label,
+# title ('' for the default).
+call 'terminal.gp' 900 700 11
 set datafile separator ','
 set key top right opaque
 set grid lc rgb '#dddddd'
-set title sprintf("Mass %d: phase portrait and Poincaré points\n{/*0.8 %s}", mass, label)
+if (!exists("title") || title eq '') title = sprintf('Mass %d: phase portrait and Poincaré points', mass)
+set title sprintf("%s\n{/*0.8 %s}", title, label)
 set xlabel sprintf('x_%d (nondimensional)', mass)
 set ylabel sprintf("x'_%d (nondimensional)", mass)
 plot trajectory using xcol:vcol every ::1 with lines lw 1 lc rgb '#4477aa' title 'trajectory', \

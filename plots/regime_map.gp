@@ -11,8 +11,7 @@ if (!exists("subtitle")) subtitle = ''
 if (!exists("dx")) dx = 0.1
 if (!exists("dy")) dy = 1.0
 set datafile separator ','
-set terminal pngcairo size 1200,800 font 'DejaVu Sans,12'
-set output out
+call 'terminal.gp' 1200 800 12
 color(c) = c == 1 ? 0x1f77b4 : c == 2 ? 0x2ca02c : c == 3 ? 0x17becf : c == 4 ? 0x9467bd : \
            c <= 8 ? 0x8c564b : c == 9 ? 0xbcbd22 : c == 10 ? 0xff7f0e : c == 11 ? 0xd62728 : \
            c == 12 ? 0x000000 : 0x7f7f7f

@@ -6,8 +6,7 @@
 # <data>/stability_cost.csv with alpha and
 # one column per method. Variables (gnuplot -e): data, out, target (a number), periods,
 # accuracy_periods, plot_title.
-set terminal pngcairo size 1500,950 enhanced font 'DejaVu Sans,10'
-set output out
+call 'terminal.gp' 1500 950 10
 set datafile separator ','
 status_colour(s) = s == 0 ? 0x228833 : s == 1 ? 0xcc3311 : s == 2 ? 0x999999 : s == 3 ? 0xee7733 : 0xaa3377
 # filled square: ok and within the target; open square: ok but less accurate; triangle: a

@@ -3,8 +3,7 @@
 # parameter, cpu_seconds, error, steps, rhs_evaluations, events, step, min_cpu_seconds, repeats.
 # Variables (gnuplot -e): data, stem, curves (space-separated keys), out, plot_title,
 # ylabel_text. The colour and marker of a method are the same in every chart.
-set terminal pngcairo size 1560,820 enhanced font 'DejaVu Sans,11'
-set output out
+call 'terminal.gp' 1560 820 11
 set datafile separator ','
 set logscale xy
 set format x '10^{%L}'
