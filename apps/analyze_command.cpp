@@ -8,6 +8,7 @@
 #include <memory>
 #include <span>
 
+#include "cli_checks.hpp"
 #include "case_options.hpp"
 #include "commands.hpp"
 #include "csv_writer.hpp"
@@ -110,8 +111,8 @@ void analyze(AnalyzeOptions o) {
   classifier.fixed_point_is_equilibrium = false;  // stroboscopic points: a fixed point is period-1
   const analysis::Classification c = analysis::classify_motion(points, evidence, classifier);
 
-  fmt::print("case: n = {}, {}; {} by {}\n", n, o.run.description(), recorded,
-             integrator->name());
+  fmt::print("case: n = {}, {}; {} Poincaré points after {} transient periods, by {}\n", n,
+             o.run.description(), recorded, o.transient, integrator->name());
   fmt::print("regime: {}\n", c.name());
   fmt::print("  period search: {} (best k = {}, mismatch {:.2e}, {} distinct points)\n",
              c.period_search.period > 0 ? fmt::format("period {}", c.period_search.period)
@@ -152,7 +153,7 @@ void add_analyze_command(CLI::App& app) {
       "Example: pwl analyze --figure 5 --periods 1000 --transient 500 --out fig5");
   add_case_options(*c, options->run);
   c->add_option("--transient", options->transient, "Periods discarded before the analysis")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_number());
   c->add_option("--mass", options->mass, "Mass (1-based) drawn in the figure (default: last)");
   c->add_option("--out", options->out, "Output folder");
   c->callback([options] { analyze(*options); });

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <memory>
 
+#include "cli_checks.hpp"
 #include "accuracy_bench.hpp"
 #include "bench_chain.hpp"
 #include "bench_scaling.hpp"
@@ -30,20 +31,20 @@ void add_chain(CLI::App& bench) {
       "Example: pwl bench chain --out out/bench\n"
       "         pwl run apps/scenes/paper_fig7-9_table1.toml   (the paper's methods, figures 7-9)");
   c->add_option("--n", o->masses, "Number of masses")->check(CLI::Range(2, 100000000));
-  c->add_option("--t-end", o->t_end, "End of the run (s)")->check(CLI::PositiveNumber);
-  c->add_option("--runs", o->runs, "Timed runs per method (median)")->check(CLI::PositiveNumber);
+  c->add_option("--t-end", o->t_end, "End of the run (s)")->check(positive_number());
+  c->add_option("--runs", o->runs, "Timed runs per method (median)")->check(positive_number());
   c->add_option("--dense-runs", o->dense_runs, "Timed runs of the dense PIM")
-      ->check(CLI::PositiveNumber);
-  c->add_option("--step", o->paper_step, "The paper's step (s)")->check(CLI::PositiveNumber);
+      ->check(positive_number());
+  c->add_option("--step", o->paper_step, "The paper's step (s)")->check(positive_number());
   c->add_option("--wished-step", o->wished_step, "η1 given to the step rule (s)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   c->add_option("--rule-bands", o->rule_bands, "q given to the step rule, comma separated")
       ->delimiter(',');
   c->add_option("--reference-tol", o->reference_tolerance, "Tolerance of the reference")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   c->add_option("--reference-grid", o->reference_grid,
                 "Spacing of the reference's recorded points (s)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   c->add_flag("!--no-reference-check", o->reference_check,
               "Skip the second reference that bounds the first's error");
   c->add_option("--methods", o->methods,
@@ -90,9 +91,9 @@ void add_scaling(CLI::App& bench) {
       "banded products of one step\n"
       "Example: pwl bench scaling --sizes 1000,4000,16000,64000,256000");
   c->add_option("--sizes", o->sizes, "Numbers of masses, comma separated")->delimiter(',');
-  c->add_option("--step", o->step, "Step (s)")->check(CLI::PositiveNumber);
-  c->add_option("--steps", o->steps, "Timed steps per repeat")->check(CLI::PositiveNumber);
-  c->add_option("--repeats", o->repeats, "Repeats (median)")->check(CLI::PositiveNumber);
+  c->add_option("--step", o->step, "Step (s)")->check(positive_number());
+  c->add_option("--steps", o->steps, "Timed steps per repeat")->check(positive_number());
+  c->add_option("--repeats", o->repeats, "Repeats (median)")->check(positive_number());
   c->add_flag("--unshared", *unshared,
               "Store every operator row (no sharing of identical rows): the memory-bound case");
   c->add_option("--out", o->out, "Folder for bench_scaling.csv");

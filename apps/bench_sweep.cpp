@@ -12,6 +12,7 @@
 #include <memory>
 #include <vector>
 
+#include "cli_checks.hpp"
 #include "pwl/analysis/parameter_grid.hpp"
 #include "pwl/analysis/parameter_sweep.hpp"
 #include "pwl/errors.hpp"
@@ -245,13 +246,13 @@ void add_sweep_bench(CLI::App& bench) {
       "Speed of a θ sweep of the 5-DOF chain: stepper throughput, parallel efficiency, and the\n"
       "sweep's wall time by the PIM beside kink-located dopri5 at the same Poincaré accuracy\n"
       "Example: pwl bench sweep --out plots/data");
-  c->add_option("--points", o->points, "Points of the θ sweep")->check(CLI::PositiveNumber);
+  c->add_option("--points", o->points, "Points of the θ sweep")->check(positive_number());
   c->add_option("--transient", o->transient, "Transient periods per point")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_number());
   c->add_option("--periods", o->periods, "Recorded periods per point")->check(CLI::Range(100, 1000000));
-  c->add_option("--repeats", o->repeats, "Timed runs (median)")->check(CLI::PositiveNumber);
+  c->add_option("--repeats", o->repeats, "Timed runs (median)")->check(positive_number());
   c->add_option("--dopri5-every", o->dopri5_every, "dopri5 on every k-th point")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   c->add_option("--out", o->out, "Folder for bench_sweep.csv");
   c->add_flag("--quiet", o->quiet, "Print only the table");
   c->callback([o] { run(*o); });

@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "cli_checks.hpp"
 #include "pwl/banded_pim_integrator.hpp"
 #include "pwl/banded_switching_pim.hpp"
 #include "pwl/errors.hpp"
@@ -16,23 +17,36 @@
 
 namespace pwl::app {
 
-void add_case_options(CLI::App& c, CaseOptions& o) {
-  c.add_option("--figure", o.figure, "Start from one of the paper's 5-DOF cases: 4a, 4b, 5, 6")
+void add_chain_options(CLI::App& c, std::string& figure, int& masses, std::vector<double>& alpha,
+                       double& zeta, double& gap, double& theta, std::vector<double>& loads) {
+  c.add_option("--figure", figure, "Start from one of the paper's 5-DOF cases: 4a, 4b, 5, 6")
       ->check(CLI::IsMember({"4a", "4b", "5", "6"}));
-  c.add_option("--n", o.masses, "Number of masses")->check(CLI::PositiveNumber);
-  c.add_option("--alpha", o.alpha, "Contact stiffness ratio k2/k1 (one value or one per mass)")
-      ->delimiter(',');
-  c.add_option("--zeta", o.zeta, "Damping ratio c/sqrt(k1 m)");
-  c.add_option("--gap", o.gap, "Nondimensional gap of every mass's spring");
+  c.add_option("--n", masses, "Number of masses")->check(positive_number());
+  // Unset chain parameters come from --figure's case, else from the chain's defaults.
+  const NondimensionalChain d;
+  const auto preset = [](double value) { return fmt::format("{} or --figure's", value); };
+  c.add_option("--alpha", alpha, "Contact stiffness ratio k2/k1 (one value or one per mass)")
+      ->delimiter(',')
+      ->default_str(preset(d.alpha[0]));
+  c.add_option("--zeta", zeta, "Damping ratio c/sqrt(k1 m)")->default_str(preset(d.zeta));
+  c.add_option("--gap", gap, "Nondimensional gap of every mass's spring")
+      ->default_str(preset(d.gap[0]));
+  c.add_option("--theta", theta, "Forcing frequency ratio ω/ω0")->default_str(preset(d.theta));
+  c.add_option("--loads", loads, "Load amplitudes Q per mass, comma separated")
+      ->delimiter(',')
+      ->default_str(fmt::format("{} or --figure's", fmt::join(d.amplitude, ",")));
+}
+
+void add_case_options(CLI::App& c, CaseOptions& o) {
+  add_chain_options(c, o.figure, o.masses, o.alpha, o.zeta, o.gap, o.theta, o.loads);
   c.add_option("--gaps", o.gaps, "Gaps per mass, comma separated (overrides --gap)")
-      ->delimiter(',');
-  c.add_option("--theta", o.theta, "Forcing frequency ratio ω/ω0");
-  c.add_option("--loads", o.loads, "Load amplitudes Q per mass, comma separated")->delimiter(',');
-  c.add_option("--periods", o.periods, "Forcing periods to integrate")->check(CLI::PositiveNumber);
+      ->delimiter(',')
+      ->default_str("");
+  c.add_option("--periods", o.periods, "Forcing periods to integrate")->check(positive_number());
   c.add_option("--skip-periods", o.skip_periods, "Leading periods left out of the output")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_number());
   c.add_option("--steps-per-period", o.steps_per_period, "PIM steps per forcing period")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   c.add_option("--dt", o.dt, "PIM step (must divide the forcing period)");
   c.add_option("--method", o.method,
                "Integrator: pim (dense or banded by size), pim-dense, pim-banded, pim-switching\n"

@@ -51,4 +51,10 @@ struct CaseOptions {
 
 void add_case_options(CLI::App& command, CaseOptions& options);
 
+// The chain's own flags (--figure, --n, --alpha, --zeta, --gap, --theta, --loads), shared with
+// the sweep and map jobs.
+void add_chain_options(CLI::App& command, std::string& figure, int& masses,
+                       std::vector<double>& alpha, double& zeta, double& gap, double& theta,
+                       std::vector<double>& loads);
+
 }  // namespace pwl::app

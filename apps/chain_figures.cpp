@@ -54,7 +54,8 @@ bool draw_chain_figures(const ChainBenchResult& r, const std::string& dir, std::
     return false;
   for (auto [fig, path, m, label] :
        {std::tuple{8, pim_errors, pim, pim_label},
-        std::tuple{9, rk_errors, rk, std::string("dopri5, rtol = atol = 1e-5 (plain, like ode45)")}}) {
+        std::tuple{9, rk_errors, rk,
+                   std::string("dopri5, rtol = atol = 1e-5 (plain, like ode45)")}}) {
     const auto definitions = [&](const std::string& format) {
       return fmt::format(
           "data='{}'; out='{}/fig{}.{}'; fig={}; method={}; params={}; reference={}; ex='{:.1e}'; "

@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,7 @@ int main(int argc, char** argv) {
       "by precise integration with one linear complementarity problem per step."};
   app.set_version_flag("--version", std::string("pwl ") + PWL_VERSION);
   app.require_subcommand(1);
+  app.option_defaults()->always_capture_default();  // --help shows every default
   pwl::app::add_simulate_command(app);
   pwl::app::add_analyze_command(app);
   pwl::app::add_reproduce_command(app);
@@ -25,6 +27,14 @@ int main(int argc, char** argv) {
   pwl::app::add_map_command(app);
   pwl::app::add_run_command(app);
   pwl::app::add_scene_options(app);
+  // An empty list's default reads "[]" in --help: show nothing instead.
+  const std::function<void(CLI::App&)> tidy = [&tidy](CLI::App& command) {
+    for (CLI::Option* o : command.get_options()) {
+      if (o->get_default_str() == "[]") o->default_str("");
+    }
+    for (CLI::App* sub : command.get_subcommands({})) tidy(*sub);
+  };
+  tidy(app);
   pwl::app::ExpandedCommandLine line;
   try {
     line = pwl::app::expand_scenes(std::vector<std::string>(argv + 1, argv + argc), app);
@@ -38,7 +48,7 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return code == 0 ? 0 : 2;
   } catch (const pwl::InputError& e) {
-    fmt::print(stderr, "pwl: bad input: {}\n", e.what());
+    fmt::print(stderr, "pwl: bad input: {}\n", pwl::app::locate_in_scene(e.what(), line));
     return 2;
   } catch (const std::exception& e) {
     fmt::print(stderr, "pwl: {}\n", e.what());

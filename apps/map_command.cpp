@@ -79,8 +79,8 @@ void add_map_command(CLI::App& app) {
   CLI::App* c = app.add_subcommand(
       "map",
       "Regime map: classify every cell of a two-parameter grid\n"
-      "Example: pwl map --x theta --x-range 0.5:3 --x-points 40 --y alpha --y-range 1:15 \\\n"
-      "           --y-points 30 --out theta_alpha");
+      "Example: pwl map --figure 5 --x theta --x-range 0.5:3 --x-points 40 --y alpha \\\n"
+      "           --y-range 1:15 --y-points 29 --out theta_alpha");
   add_chain_flags(*c, flags->chain);
   c->add_option("--x", flags->x, "Horizontal parameter: theta, alpha, zeta, gap or amplitude");
   c->add_option("--x-range", flags->x_range, "FROM:TO of the horizontal parameter");

@@ -101,13 +101,13 @@ ComparisonResult simulate_with_comparison(const CaseOptions& run, const Comparis
     for (int k = 1; k <= run.periods; ++k) {
       const bool keep = k > run.skip_periods;
       for (long j = 1; j <= steps; ++j) {
-        const double t = (static_cast<double>(k - 1) * static_cast<double>(steps) +
-                          static_cast<double>(j)) * eta;
+        const double t =
+            (static_cast<double>(k - 1) * static_cast<double>(steps) + static_cast<double>(j)) *
+            eta;
         a->advance_to(j == steps ? k * period : t);
         b->advance_to(a->time());
-        const double difference =
-            std::max((a->position() - b->position()).cwiseAbs().maxCoeff(),
-                     (a->velocity() - b->velocity()).cwiseAbs().maxCoeff());
+        const double difference = std::max((a->position() - b->position()).cwiseAbs().maxCoeff(),
+                                           (a->velocity() - b->velocity()).cwiseAbs().maxCoeff());
         result.largest_difference = std::max(result.largest_difference, difference);
         if (k > drawn_from) write(trajectory_a, *a), write(trajectory_b, *b);
         if (j == steps && keep) {

@@ -14,7 +14,9 @@ std::string scenes_directory();
 struct ReproducedScene {
   std::string key;    // for --only: "4a", "4b", "5", "6", "7-9", "theta-sweep", "theta-alpha-map"
   std::string scene;  // file name in the scenes folder
-  // --set overrides of a smoke run (--quick): shorter runs, smaller grids.
+  // --set overrides of every run (the paper's figure title) and of a smoke run (--quick: shorter
+  // runs, smaller grids).
+  std::vector<std::string> always;
   std::vector<std::string> quick;
   // (file written by the scene, name of the figure under plots/), without the extension.
   std::vector<std::pair<std::string, std::string>> figures;

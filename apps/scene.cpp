@@ -360,7 +360,9 @@ Scene parse_scene(std::string_view text, const std::string& name,
       throw InputError(fmt::format("{}: '{}' is not a key: section.key, lowercase", at, key));
     }
     if (dot == std::string::npos && key != "job") {
-      throw InputError(fmt::format("{}: '{}' needs its section, e.g. method.{}", at, key, key));
+      throw InputError(fmt::format(
+          "{}: '{}' needs its section, e.g. structure.{} (sections: {})", at, key, key,
+          fmt::join(scene_sections(), ", ")));
     }
     toml::table doc;
     try {

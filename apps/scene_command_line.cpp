@@ -211,15 +211,32 @@ ExpandedCommandLine expand_scenes(const std::vector<std::string>& args, const CL
   return out;
 }
 
+namespace {
+
+// Whether `word` occurs in `text` on its own (not inside a longer name like "skip-periods").
+bool names(const std::string& text, const std::string& word) {
+  const auto part_of_name = [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_';
+  };
+  for (std::size_t at = text.find(word); at != std::string::npos; at = text.find(word, at + 1)) {
+    const std::size_t end = at + word.size();
+    if ((at == 0 || !part_of_name(text[at - 1])) &&
+        (end == text.size() || !part_of_name(text[end])))
+      return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 std::string locate_in_scene(const std::string& message, const ExpandedCommandLine& line) {
+  // The message names the flag ("--record 9: ...") or the setting ("theta = -1.1 must be ...").
   for (const SceneSetting& s : line.settings) {
-    const std::size_t at = message.find(s.flag);
-    if (at == std::string::npos) continue;
-    const std::size_t end = at + s.flag.size();
-    if (end < message.size() &&
-        (std::isalnum(static_cast<unsigned char>(message[end])) || message[end] == '-'))
-      continue;
-    return fmt::format("{} (set by {}: {})", message, s.where, s.key);
+    const std::string name = s.flag.substr(2);
+    std::string underscored = name;
+    std::replace(underscored.begin(), underscored.end(), '-', '_');
+    if (names(message, s.flag) || names(message, name) || names(message, underscored))
+      return fmt::format("{}: {}: {}", s.where, s.key, message);
   }
   return message;
 }
@@ -231,7 +248,6 @@ void add_scene_options(CLI::App& app) {
     add_scene_options_to(*job);
   }
 }
-
 
 void add_run_command(CLI::App& app) {
   static std::string unused_path;

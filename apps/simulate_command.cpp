@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "case_options.hpp"
+#include "cli_checks.hpp"
 #include "commands.hpp"
 #include "csv_writer.hpp"
 #include "gnuplot.hpp"
@@ -115,7 +116,7 @@ void add_simulate_command(CLI::App& app) {
       ->delimiter(',');
   c->add_option("--trajectory-periods", output.trajectory_periods,
                 "Write the trajectory of only the last N periods (0: every kept period)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_number());
   c->add_option("--title", output.title, "Title of the figure");
   c->add_option("--compare-with", options->compare.method,
                 "Integrate the case again by this method, on the same time grid, and compare")
@@ -123,7 +124,7 @@ void add_simulate_command(CLI::App& app) {
                              "pim-switching-banded", "exact", "dopri5", "rkf78"}));
   c->add_option("--compare-tol", options->compare.tolerance,
                 "Tolerance of the compared method (dopri5/rkf78)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   c->add_flag("--compare-locate-kinks", options->compare.locate_kinks,
               "The compared dopri5/rkf78 ends a step at every spring switch");
   c->add_option("--out", output.out, "Output folder");

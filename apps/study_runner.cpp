@@ -11,6 +11,7 @@
 #include <memory>
 #include <sstream>
 
+#include "cli_checks.hpp"
 #include "case_options.hpp"
 #include "distributed.hpp"
 #include "progress_bar.hpp"
@@ -36,15 +37,7 @@ NondimensionalChain ChainFlags::chain() const {
 }
 
 void add_chain_flags(CLI::App& c, ChainFlags& f) {
-  c.add_option("--figure", f.figure, "Start from one of the paper's 5-DOF cases: 4a, 4b, 5, 6")
-      ->check(CLI::IsMember({"4a", "4b", "5", "6"}));
-  c.add_option("--n", f.masses, "Number of masses")->check(CLI::PositiveNumber);
-  c.add_option("--alpha", f.alpha, "Contact stiffness ratio k2/k1 (one value or one per mass)")
-      ->delimiter(',');
-  c.add_option("--zeta", f.zeta, "Damping ratio c/sqrt(k1 m)");
-  c.add_option("--gap", f.gap, "Nondimensional gap of every mass's spring");
-  c.add_option("--theta", f.theta, "Forcing frequency ratio ω/ω0");
-  c.add_option("--loads", f.loads, "Load amplitudes Q per mass, comma separated")->delimiter(',');
+  add_chain_options(c, f.figure, f.masses, f.alpha, f.zeta, f.gap, f.theta, f.loads);
 }
 
 analysis::PointSettings PointFlags::settings(int masses) const {
@@ -93,7 +86,7 @@ void add_run_flags(CLI::App& c, RunFlags& f) {
   c.add_flag("--quiet", f.quiet, "No progress bar");
   c.add_flag("--no-plot", f.no_plot, "Write the CSV files only");
   c.add_option("--threads", f.threads, "OpenMP threads (default: all cores)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_number());
 }
 
 void parse_range(const std::string& flag, const std::string& text, double* from, double* to) {

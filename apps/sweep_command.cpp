@@ -48,27 +48,30 @@ analysis::SweepOptions sweep_options(const SweepFlags& f) {
 
 // What the bifurcation diagram draws: the first recorded component of every Poincaré point,
 // with the points of one parameter value and direction that fall within 1/1000 of the plotted
-// range of each other (under a pixel) kept once (a periodic orbit's hundreds of returns are a few points), so
-// that the SVG stays small. Same columns as poincare.csv, one component.
+// range of each other (under a pixel) kept once (a periodic orbit's hundreds of returns are a few
+// points), so that the SVG stays small. Same columns as poincare.csv, one component.
 void write_plotted_points(const analysis::SweepOptions& o,
                           const std::map<long, analysis::PointResult>& records,
                           const std::string& path) {
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (const auto& [id, r] : records) {
     for (int k = 0; k < r.rows(); ++k) {
-      const double y = r.poincare[static_cast<std::size_t>(k) * static_cast<std::size_t>(r.columns)];
+      const double y =
+          r.poincare[static_cast<std::size_t>(k) * static_cast<std::size_t>(r.columns)];
       if (std::isfinite(y)) lo = std::min(lo, y), hi = std::max(hi, y);
     }
   }
   const double cell = hi > lo ? (hi - lo) / 1000.0 : 1.0;
   std::FILE* file = std::fopen(path.c_str(), "w");
   if (file == nullptr) throw Error(fmt::format("cannot write {}", path));
-  fmt::print(file, "{},direction,index,period_index,value\n", analysis::parameter_name(o.parameter));
+  fmt::print(file, "{},direction,index,period_index,value\n",
+             analysis::parameter_name(o.parameter));
   for (const auto& [id, r] : records) {
     const int index = static_cast<int>(id % o.points);
     std::set<long long> seen;
     for (int k = 0; k < r.rows(); ++k) {
-      const double y = r.poincare[static_cast<std::size_t>(k) * static_cast<std::size_t>(r.columns)];
+      const double y =
+          r.poincare[static_cast<std::size_t>(k) * static_cast<std::size_t>(r.columns)];
       if (!std::isfinite(y) || !seen.insert(std::llround((y - lo) / cell)).second) continue;
       fmt::print(file, "{:.17g},{},{},{},{:.17g}\n", o.value(index), id < o.points ? "up" : "down",
                  index, o.point.transient_periods + k + 1, y);

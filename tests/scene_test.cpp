@@ -118,7 +118,7 @@ TEST_CASE("scene: bad scenes are refused with file, line and key", "[scene]") {
         std::string::npos);
   CHECK(message_of([] {
           parse_scene("", "c.toml", {"theta=1"});
-        }).find("needs its section, e.g. method.theta") != std::string::npos);
+        }).find("needs its section, e.g. structure.theta") != std::string::npos);
   CHECK(message_of([] { parse_scene("", "c.toml", {"=1"}); }).find("expected key=value") !=
         std::string::npos);
   CHECK(message_of([] {
