@@ -7,17 +7,9 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include "shell_command.hpp"
+
 namespace pwl::app {
-namespace {
-
-// `text` quoted for the shell.
-std::string shell_quoted(const std::string& text) {
-  std::string quoted = "'";
-  for (char c : text) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return quoted + "'";
-}
-
-}  // namespace
 
 std::string gnuplot_quoted(const std::string& text) {
   std::string quoted = "'";
@@ -37,8 +29,8 @@ bool run_gnuplot(const std::string& script, const std::string& definitions, std:
     *why = "cannot create a temporary file for gnuplot";
     return false;
   }
-  const std::string text = fmt::format("set loadpath {}\n{}\n", gnuplot_quoted(plots_directory()),
-                                       definitions);
+  const std::string text =
+      fmt::format("set loadpath {}\n{}\n", gnuplot_quoted(plots_directory()), definitions);
   const bool written = write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size());
   close(fd);
   const std::string command =

@@ -13,14 +13,19 @@
 
 namespace pwl::app {
 
-int count_distinct_points(const std::vector<std::pair<double, double>>& points, double tolerance) {
-  if (points.empty()) return 0;
+double cloud_diameter(const std::vector<std::pair<double, double>>& points) {
+  if (points.empty()) return 0.0;
   double lo_x = points[0].first, hi_x = lo_x, lo_v = points[0].second, hi_v = lo_v;
   for (auto [x, v] : points) {
     lo_x = std::min(lo_x, x), hi_x = std::max(hi_x, x);
     lo_v = std::min(lo_v, v), hi_v = std::max(hi_v, v);
   }
-  const double radius = tolerance * std::max(1.0, std::hypot(hi_x - lo_x, hi_v - lo_v));
+  return std::hypot(hi_x - lo_x, hi_v - lo_v);
+}
+
+int count_distinct_points(const std::vector<std::pair<double, double>>& points, double tolerance) {
+  if (points.empty()) return 0;
+  const double radius = tolerance * std::max(1.0, cloud_diameter(points));
   std::vector<std::pair<double, double>> centres;
   for (auto p : points) {
     const bool seen = std::any_of(centres.begin(), centres.end(), [&](auto c) {
@@ -32,16 +37,6 @@ int count_distinct_points(const std::vector<std::pair<double, double>>& points, 
 }
 
 namespace {
-
-double cloud_diameter(const std::vector<std::pair<double, double>>& points) {
-  if (points.empty()) return 0.0;
-  double lo_x = points[0].first, hi_x = lo_x, lo_v = points[0].second, hi_v = lo_v;
-  for (auto [x, v] : points) {
-    lo_x = std::min(lo_x, x), hi_x = std::max(hi_x, x);
-    lo_v = std::min(lo_v, v), hi_v = std::max(hi_v, v);
-  }
-  return std::hypot(hi_x - lo_x, hi_v - lo_v);
-}
 
 std::string method_label(const std::string& method, double tolerance, bool locate_kinks) {
   if (method == "pim" || method == "pim-dense" || method == "pim-banded") return "PIM";

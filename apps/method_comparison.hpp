@@ -40,6 +40,9 @@ struct ComparisonResult {
 ComparisonResult simulate_with_comparison(const CaseOptions& run, const ComparisonOptions& with,
                                           const RecordingOptions& output);
 
+// The diameter of a cloud of (x, x') points: the diagonal of its bounding box.
+double cloud_diameter(const std::vector<std::pair<double, double>>& points);
+
 // Distinct points of a cloud: greedy clustering with radius tolerance * (cloud diameter), with
 // the diameter floored at 1 so that a fixed point counts as one.
 int count_distinct_points(const std::vector<std::pair<double, double>>& points, double tolerance);

@@ -2,37 +2,11 @@
 
 #include <fmt/format.h>
 
-#include <array>
-#include <cstdio>
 #include <cstdlib>
-#include <memory>
 
-#include "pwl/errors.hpp"
+#include "shell_command.hpp"
 
 namespace pwl::app {
-namespace {
-
-// Runs `command`, returns what it printed (stdout and stderr); throws on a non-zero exit.
-std::string capture(const std::string& command) {
-  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen((command + " 2>&1").c_str(), "r"), pclose);
-  if (!pipe) throw Error(fmt::format("cannot run: {}", command));
-  std::string out;
-  std::array<char, 4096> buffer{};
-  while (std::fgets(buffer.data(), static_cast<int>(buffer.size()), pipe.get()) != nullptr) {
-    out += buffer.data();
-  }
-  const int status = pclose(pipe.release());
-  if (status != 0) throw Error(fmt::format("{} failed:\n{}", command, out));
-  return out;
-}
-
-std::string shell_quoted(const std::string& s) {
-  std::string quoted = "'";
-  for (char c : s) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return quoted + "'";
-}
-
-}  // namespace
 
 std::string scenes_directory() {
   if (const char* env = std::getenv("PWL_SCENES_DIR")) return env;
@@ -58,9 +32,15 @@ const std::vector<ReproducedScene>& reproduced_scenes() {
        {"output.title=Figure 4b: mass 5, the PIM against a kink-located reference"},
        {"run.periods=300", "run.skip_periods=200"},
        {{"comparison", "fig4b"}}},
-      {"5", "paper_fig5.toml", {}, {"run.periods=400", "analysis.transient=250"},
+      {"5",
+       "paper_fig5.toml",
+       {},
+       {"run.periods=400", "analysis.transient=250"},
        {{"analysis", "analysis_fig5"}}},
-      {"6", "paper_fig6.toml", {}, {"run.periods=400", "analysis.transient=250"},
+      {"6",
+       "paper_fig6.toml",
+       {},
+       {"run.periods=400", "analysis.transient=250"},
        {{"analysis", "analysis_fig6"}}},
       {"7-9",
        "paper_fig7-9_table1.toml",
@@ -81,8 +61,8 @@ const std::vector<ReproducedScene>& reproduced_scenes() {
   return scenes;
 }
 
-std::string run_scene(const std::string& self, const ReproducedScene& scene,
-                      const std::string& out, bool quick) {
+std::string run_scene(const std::string& self, const ReproducedScene& scene, const std::string& out,
+                      bool quick) {
   std::string command =
       fmt::format("{} run {} --set output.out={}", shell_quoted(self),
                   shell_quoted(scenes_directory() + "/" + scene.scene), shell_quoted(out));
@@ -90,7 +70,7 @@ std::string run_scene(const std::string& self, const ReproducedScene& scene,
   if (quick) {
     for (const std::string& s : scene.quick) command += " --set " + shell_quoted(s);
   }
-  return capture(command);
+  return captured_output(command);
 }
 
 }  // namespace pwl::app
