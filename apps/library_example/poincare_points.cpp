@@ -7,9 +7,9 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
-#include <pwl/event_driven_solver.hpp>
-#include <pwl/gap_structure.hpp>
-#include <pwl/pim_integrator.hpp>
+#include <pwl/integrators/event_driven_solver.hpp>
+#include <pwl/model/gap_structure.hpp>
+#include <pwl/integrators/pim_integrator.hpp>
 
 int main() {
   pwl::GapStructure s;

@@ -1,0 +1,46 @@
+#pragma once
+// Runs the points of a parameter study, in parallel where the study allows it.
+//
+// A study is a list of tasks. A task is a list of point ids computed in order: in an independent
+// study every task holds one point, started from the same initial state; in a continuation every
+// task is a branch (a sweep upward or downward, a row of a regime map) whose points each start
+// from the final state of the point before, which is what shows hysteresis and coexisting
+// attractors. A branch is inherently sequential, so the parallelism of a continuation is across
+// branches, not along them.
+//
+// Tasks are spread over OpenMP threads with a dynamic schedule (a chaotic point costs no more
+// than a periodic one, but unbounded ones stop early, so the work per task varies). Each point
+// depends only on its own chain and its initial state, so the results do not depend on the number
+// of threads or on the order in which tasks finish; callers that write files sort by id.
+#include <functional>
+#include <map>
+#include <vector>
+
+#include "pwl/study/sweep_point.hpp"
+
+namespace pwl::analysis {
+
+struct GridTask {
+  std::vector<long> ids;      // in the order they are computed
+  bool continuation = false;  // each point starts from the previous point's final state
+};
+
+// The chain of point `id`.
+using PointChain = std::function<NondimensionalChain(long id)>;
+// Told about every point finished in this run. Called by one thread at a time.
+using PointSink = std::function<void(long id, const PointResult& result)>;
+
+struct GridRun {
+  int threads = 0;  // OpenMP threads; 0: the OpenMP default
+};
+
+// Computes every point of `tasks` that is not in `done`. A continuation that meets a point in
+// `done` takes its final state from there (a resumed run continues where the killed one stopped);
+// after a point whose motion blew up (no final state) it restarts from `initial_state`.
+// Exceptions from a point (bad input) are rethrown on the calling thread after the loop.
+void run_grid(const std::vector<GridTask>& tasks, const PointChain& chain_of,
+              const Vector& initial_state, const PointSettings& settings,
+              const std::map<long, PointResult>& done, const PointSink& sink,
+              const GridRun& run = {});
+
+}  // namespace pwl::analysis

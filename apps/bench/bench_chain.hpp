@@ -1,0 +1,68 @@
+#pragma once
+// `pwl bench chain`: the paper's section 4.2 problem (He, Gao & Zhong 2018, Table 1; SPEC.md §5)
+// measured side by side: n = 1000 masses, t in [0, 200] s from rest, the banded PIM at the
+// paper's step and at the step its rule picks, the dense PIM, and dopri5 at 1e-5 and 1e-10, plain
+// (like the paper's ode45) and kink-located. For each: the median wall and CPU time of several
+// runs and the largest error of x1 and x1' against a kink-located reference at 1e-12.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bench/bench_reference.hpp"
+#include "pwl/integrators/banded_step_rule.hpp"
+
+namespace pwl::app {
+
+struct ChainBenchOptions {
+  int masses = 1000;
+  double t_end = 200.0;        // s
+  int runs = 5;                // timed runs per method (the median is reported)
+  int dense_runs = 1;          // the dense PIM takes minutes per run at n = 1000
+  double paper_step = 0.02;    // s, the step the paper reports
+  double wished_step = 0.32;   // s, η1 given to the step rule
+  std::vector<int> rule_bands{5, 8};  // q given to the step rule (the paper: 5, its 11-dof piece)
+  double reference_tolerance = 1e-12;
+  double reference_grid = 0.005;      // s, spacing of the reference's recorded points
+  bool reference_check = true;        // a second reference (dopri5) to bound the first's error
+  // Which methods to run (keys of chain_bench_methods()); empty: all.
+  std::vector<std::string> methods;
+  std::string out = "out/bench";      // CSV files and the cached reference
+  bool figures = false;               // also draw the paper's figures 7-9 (chain_figures.hpp)
+  bool quiet = false;
+};
+
+// Keys of the methods, in table order.
+std::vector<std::string> chain_bench_methods();
+
+struct ChainMethodResult {
+  std::string key;
+  std::string label;       // e.g. "banded PIM (paper step)"
+  std::string parameters;  // e.g. "η = 0.02 s, q = 5"
+  int runs = 0;
+  double wall = 0.0;        // median wall time of a run (set-up + integration), s
+  double cpu = 0.0;         // median CPU time (all threads), s
+  double setup = 0.0;       // median wall time of the set-up alone, s
+  long steps = 0;
+  long work = 0;            // right-hand-side evaluations (Runge-Kutta) or LCP pivots (PIM)
+  double error_x = 0.0;     // largest |x1 - reference| over the run, m
+  double error_v = 0.0;     // largest |x1' - reference|, m/s
+  TrackRecord record;       // x1, x1' at every step of the first run
+};
+
+struct ChainBenchResult {
+  ChainBenchOptions options;
+  std::vector<ChainMethodResult> methods;
+  ReferenceTrack reference;
+  std::string reference_label;
+  double reference_seconds = 0.0;
+  std::optional<std::pair<double, double>> reference_check;  // |rkf78 - dopri5| in x1, x1'
+  std::vector<BandedStepChoice> rule_choices;                 // per rule band
+};
+
+// Runs the benchmark (printing progress unless quiet) and writes <out>/bench_chain.csv.
+ChainBenchResult run_chain_bench(const ChainBenchOptions& options);
+
+// The table with the paper's beside it, and the targets met or missed.
+std::string format_chain_table(const ChainBenchResult& result);
+
+}  // namespace pwl::app

@@ -1,0 +1,227 @@
+#include "bench/bench_scaling.hpp"
+
+#include <spawn.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "pwl/integrators/banded_propagator.hpp"
+#include "pwl/model/chain_builders.hpp"
+#include "pwl/errors.hpp"
+
+extern char** environ;
+
+namespace pwl::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// CPU time of this thread: on a machine shared with other jobs, the wall clock also counts the
+// time the thread waited for a core.
+double thread_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// Median over repeats of the CPU time per call of `body`, called `calls` times per repeat.
+template <class Body>
+double time_per_call_us(int repeats, int calls, Body&& body) {
+  std::vector<double> per;
+  for (int r = 0; r < repeats; ++r) {
+    const double t0 = thread_seconds();
+    for (int k = 0; k < calls; ++k) body();
+    per.push_back(1e6 * (thread_seconds() - t0) / calls);
+  }
+  return median(per);
+}
+
+}  // namespace
+
+void run_scaling_single(long masses, const ScalingBenchOptions& o) {
+  const GapStructure structure = make_chain(paper_large_chain(static_cast<int>(masses)));
+  const auto t0 = Clock::now();
+  BandedExponentialOptions band;
+  band.share_rows = o.share_rows;
+  BandedPropagator propagator(make_banded_step_operators(structure, o.step, band));
+  const double setup = std::chrono::duration<double>(Clock::now() - t0).count();
+  const Vector rest = Vector::Zero(masses);
+  // Every size times the same stretch of motion (steps 20 .. 20 + steps from rest, so that the
+  // springs act as much per mass), repeated until each size has done about the same work: a
+  // short repeat of a small chain is otherwise at the mercy of the scheduler.
+  const long work = std::max<long>(1, 50'000'000L / (masses * o.steps));
+  const int repeats = std::max<int>(o.repeats, static_cast<int>(std::min<long>(work, 200)));
+  std::vector<double> per_step;
+  for (int r = 0; r < repeats; ++r) {
+    propagator.set_state(0.0, rest, rest);
+    for (int k = 0; k < 20; ++k) propagator.step();
+    const double c0 = thread_seconds();
+    for (int k = 0; k < o.steps; ++k) propagator.step();
+    per_step.push_back(1e6 * (thread_seconds() - c0) / o.steps);
+  }
+  const double step_us = median(per_step);
+
+  // The same products on their own, on copies of the stepper's vectors.
+  const BandedStepOperators& ops = propagator.operators();
+  Vector state = propagator.state(), out(state.size());
+  const Vector forces = propagator.spring_forces();
+  Vector p(forces.size());
+  for (std::size_t j = 0; j < ops.spring_order.size(); ++j) {
+    p[static_cast<Index>(j)] = forces[ops.spring_order[j]];
+  }
+  volatile double sink = 0.0;
+  const double transition_us = time_per_call_us(repeats, o.steps, [&] {
+    ops.transition.multiply(state.data(), out.data());
+    sink = sink + out[0];
+  });
+  const double products_us = time_per_call_us(repeats, o.steps, [&] {
+    ops.transition.multiply(state.data(), out.data());
+    ops.force_now.multiply_add(p.data(), out.data());
+    ops.force_next.multiply_add(p.data(), out.data());
+    sink = sink + out[0];
+  });
+  fmt::print("masses={} band={} setup={:.6g} step_us={:.6g} transition_us={:.6g} "
+             "products_us={:.6g} operator_mb={:.6g} stored_rows={} repeats={}\n",
+             masses, ops.truncation.band, setup, step_us, transition_us, products_us,
+             static_cast<double>(propagator.memory_bytes()) / 1e6, ops.transition.stored_rows(),
+             repeats);
+  std::fflush(stdout);
+}
+
+std::vector<ScalingRow> run_scaling_bench(const ScalingBenchOptions& o,
+                                          const std::string& self_exe) {
+  if (o.sizes.empty() || o.steps < 1 || o.repeats < 1 || !(o.step > 0.0)) {
+    throw InputError("bench scaling: give at least one size, steps >= 1, repeats >= 1, step > 0");
+  }
+  std::filesystem::create_directories(o.out);
+  std::vector<ScalingRow> rows;
+  for (long n : o.sizes) {
+    if (n < 2) throw InputError(fmt::format("bench scaling: size {} must be at least 2", n));
+    if (!o.quiet) {
+      fmt::print("n = {} ...\n", n);
+      std::fflush(stdout);
+    }
+    std::vector<std::string> args{self_exe,
+                                  "bench",
+                                  "scaling",
+                                  "--single",
+                                  std::to_string(n),
+                                  "--step",
+                                  fmt::format("{:.17g}", o.step),
+                                  "--steps",
+                                  std::to_string(o.steps),
+                                  "--repeats",
+                                  std::to_string(o.repeats)};
+    if (!o.share_rows) args.push_back("--unshared");
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    int pipe_fd[2];
+    if (pipe(pipe_fd) != 0) throw Error("bench scaling: cannot create a pipe");
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_adddup2(&actions, pipe_fd[1], STDOUT_FILENO);
+    posix_spawn_file_actions_addclose(&actions, pipe_fd[0]);
+    pid_t pid = 0;
+    const int spawned =
+        posix_spawn(&pid, self_exe.c_str(), &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    close(pipe_fd[1]);
+    if (spawned != 0) {
+      close(pipe_fd[0]);
+      throw Error(fmt::format("bench scaling: cannot run {}", self_exe));
+    }
+    std::string output;
+    char buffer[4096];
+    for (ssize_t got; (got = read(pipe_fd[0], buffer, sizeof buffer)) > 0;) {
+      output.append(buffer, static_cast<std::size_t>(got));
+    }
+    close(pipe_fd[0]);
+    int status = 0;
+    rusage usage{};
+    wait4(pid, &status, 0, &usage);
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+      throw Error(fmt::format("bench scaling: the run for n = {} failed:\n{}", n, output));
+    }
+    ScalingRow row;
+    const std::size_t at = output.rfind("masses=");
+    if (at == std::string::npos ||
+        std::sscanf(output.c_str() + at,
+                    "masses=%ld band=%ld setup=%lf step_us=%lf transition_us=%lf products_us=%lf "
+                    "operator_mb=%lf stored_rows=%ld repeats=%d",
+                    &row.masses, &row.band, &row.setup_seconds, &row.step_us, &row.transition_us,
+                    &row.products_us, &row.operator_mb, &row.stored_rows, &row.repeats) != 9) {
+      throw Error(fmt::format("bench scaling: unexpected output for n = {}:\n{}", n, output));
+    }
+    row.peak_rss_mb = static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB
+    if (!o.quiet) {
+      fmt::print("  band {}, step {:.1f} us, T v {:.1f} us, products {:.1f} us, peak {:.1f} MB\n",
+                 row.band, row.step_us, row.transition_us, row.products_us, row.peak_rss_mb);
+    }
+    rows.push_back(row);
+  }
+  std::FILE* f = std::fopen((o.out + "/bench_scaling.csv").c_str(), "w");
+  if (f == nullptr) throw Error(fmt::format("cannot write {}/bench_scaling.csv", o.out));
+  fmt::print(f, "masses,band,setup_s,step_us,transition_us,products_us,operator_mb,stored_rows,"
+                "peak_rss_mb\n");
+  for (const ScalingRow& r : rows) {
+    fmt::print(f, "{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{},{:.6g}\n", r.masses, r.band,
+               r.setup_seconds, r.step_us, r.transition_us, r.products_us, r.operator_mb,
+               r.stored_rows, r.peak_rss_mb);
+  }
+  std::fclose(f);
+  return rows;
+}
+
+std::string format_scaling_table(const std::vector<ScalingRow>& rows,
+                                 const ScalingBenchOptions& o) {
+  std::string s = fmt::format(
+      "\nBanded PIM on the paper's chain from rest, η = {:g} s: CPU time of this thread per step "
+      "over steps 20 to {}, median over repeats (more for small n){}.\n"
+      "Floor: the bare product T v with the stepper's T; T v + Ψ P + Φ P as dense-row products "
+      "(the stepper adds Ψ P and Φ P from the acting springs' columns only).\n\n"
+      "| n | band q | repeats | set-up s | step us | step ns / mass | T v us | T v + Ψ P + Φ P us | "
+      "step / (T v) | operators MB | T rows stored | peak RSS MB |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+      o.step, 20 + o.steps, o.share_rows ? "" : "; every row stored (no sharing)");
+  for (const ScalingRow& r : rows) {
+    s += fmt::format("| {} | {} | {} | {:.3f} | {:.1f} | {:.2f} | {:.1f} | {:.1f} | {:.2f} | {:.2f} | "
+                     "{} | {:.1f} |\n",
+                     r.masses, r.band, r.repeats, r.setup_seconds, r.step_us,
+                     1e3 * r.step_us / static_cast<double>(r.masses), r.transition_us,
+                     r.products_us, r.step_us / r.transition_us, r.operator_mb, r.stored_rows,
+                     r.peak_rss_mb);
+  }
+  if (rows.size() >= 2) {
+    const ScalingRow& a = rows.front();
+    const ScalingRow& b = rows.back();
+    const double size_ratio = static_cast<double>(b.masses) / static_cast<double>(a.masses);
+    const double time_ratio = b.step_us / a.step_us;
+    s += fmt::format(
+        "\nn x{:.0f}: time per step x{:.1f}{}, bare T v x{:.1f}, operator memory x{:.1f}, peak RSS "
+        "x{:.1f} (+{:.2f} kB per mass between the two).\n",
+        size_ratio, time_ratio,
+        size_ratio == 256 ? (time_ratio < 300 ? " (target < 300: met)" : " (target < 300: missed)")
+                          : "",
+        b.transition_us / a.transition_us, b.operator_mb / a.operator_mb, b.peak_rss_mb / a.peak_rss_mb,
+        1e3 * (b.peak_rss_mb - a.peak_rss_mb) / static_cast<double>(b.masses - a.masses));
+  }
+  return s;
+}
+
+}  // namespace pwl::app

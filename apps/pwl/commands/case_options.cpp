@@ -1,0 +1,166 @@
+#include "commands/case_options.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <cmath>
+
+#include "commands/cli_checks.hpp"
+#include "pwl/integrators/banded_pim_integrator.hpp"
+#include "pwl/integrators/banded_switching_pim.hpp"
+#include "pwl/errors.hpp"
+#include "pwl/integrators/event_driven_solver.hpp"
+#include "pwl/integrators/pim_integrator.hpp"
+#include "pwl/integrators/reference_integrator.hpp"
+#include "pwl/integrators/switching_pim.hpp"
+#include "scene/scene_structure.hpp"
+
+namespace pwl::app {
+
+void add_chain_options(CLI::App& c, std::string& figure, int& masses, std::vector<double>& alpha,
+                       double& zeta, double& gap, double& theta, std::vector<double>& loads) {
+  c.add_option("--figure", figure, "Start from one of the paper's 5-DOF cases: 4a, 4b, 5, 6")
+      ->check(CLI::IsMember({"4a", "4b", "5", "6"}));
+  c.add_option("--n", masses, "Number of masses")->check(positive_number());
+  // Unset chain parameters come from --figure's case, else from the chain's defaults.
+  const NondimensionalChain d;
+  const auto preset = [](double value) { return fmt::format("{} or --figure's", value); };
+  c.add_option("--alpha", alpha, "Contact stiffness ratio k2/k1 (one value or one per mass)")
+      ->delimiter(',')
+      ->default_str(preset(d.alpha[0]));
+  c.add_option("--zeta", zeta, "Damping ratio c/sqrt(k1 m)")->default_str(preset(d.zeta));
+  c.add_option("--gap", gap, "Nondimensional gap of every mass's spring")
+      ->default_str(preset(d.gap[0]));
+  c.add_option("--theta", theta, "Forcing frequency ratio ω/ω0")->default_str(preset(d.theta));
+  c.add_option("--loads", loads, "Load amplitudes Q per mass, comma separated")
+      ->delimiter(',')
+      ->default_str(fmt::format("{} or --figure's", fmt::join(d.amplitude, ",")));
+}
+
+void add_case_options(CLI::App& c, CaseOptions& o) {
+  add_chain_options(c, o.figure, o.masses, o.alpha, o.zeta, o.gap, o.theta, o.loads);
+  c.add_option("--gaps", o.gaps, "Gaps per mass, comma separated (overrides --gap)")
+      ->delimiter(',')
+      ->default_str("");
+  c.add_option("--periods", o.periods, "Forcing periods to integrate")->check(positive_number());
+  c.add_option("--skip-periods", o.skip_periods, "Leading periods left out of the output")
+      ->check(non_negative_number());
+  c.add_option("--steps-per-period", o.steps_per_period, "PIM steps per forcing period")
+      ->check(positive_number());
+  c.add_option("--dt", o.dt, "PIM step (must divide the forcing period)");
+  c.add_option("--method", o.method,
+               "Integrator: pim (dense or banded by size), pim-dense, pim-banded, pim-switching\n"
+               "(higher order, located switches; dense or banded by size), pim-switching-banded,\n"
+               "exact (event-driven), dopri5 or rkf78")
+      ->check(CLI::IsMember({"pim", "pim-dense", "pim-banded", "pim-switching",
+                             "pim-switching-banded", "exact", "dopri5", "rkf78"}));
+  c.add_option("--tol", o.tolerance, "Relative and absolute tolerance of dopri5/rkf78");
+  c.add_flag("--locate-kinks", o.locate_kinks,
+             "dopri5/rkf78: end a step exactly at every spring opening or closing");
+  c.add_option("--structure-scene", o.structure_scene,
+               "Integrate the explicit structure (M, C, K, gap springs, loads) of this scene\n"
+               "file's [structure] table instead of the chain")
+      ->check(CLI::ExistingFile);
+  c.add_option("--lcp", o.lcp_solver, "PIM's LCP solver: block-pivoting or lemke")
+      ->check(CLI::IsMember({"block-pivoting", "lemke"}));
+}
+
+GapStructure CaseOptions::structure() const {
+  if (!explicit_structure()) return make_chain(chain());
+  const bool chain_flags = !figure.empty() || !alpha.empty() || !std::isnan(zeta) ||
+                           !std::isnan(gap) || !gaps.empty() || !std::isnan(theta) ||
+                           !loads.empty() || masses != 5;
+  if (chain_flags) {
+    throw InputError(fmt::format(
+        "--structure-scene {}: the chain's flags (--figure, --n, --alpha, --zeta, --gap, --gaps, "
+        "--theta, --loads) do not apply to an explicit structure",
+        structure_scene));
+  }
+  return read_scene_structure(structure_scene);
+}
+
+double CaseOptions::period() const {
+  return explicit_structure() ? structure().common_period() : chain().period();
+}
+
+std::string CaseOptions::description() const {
+  if (explicit_structure()) return fmt::format("the structure of {}", structure_scene);
+  const NondimensionalChain c = chain();
+  return fmt::format("α = {}, ζ = {}, Δ̃ = {}, θ = {}", fmt::join(c.alpha, ","), c.zeta,
+                     fmt::join(c.gap, ","), c.theta);
+}
+
+NondimensionalChain CaseOptions::chain() const {
+  NondimensionalChain c;
+  if (!figure.empty()) c = paper_five_dof_case(figure);
+  c.masses = masses;
+  if (!alpha.empty()) c.alpha = alpha;
+  if (!std::isnan(zeta)) c.zeta = zeta;
+  if (!gaps.empty()) {
+    c.gap = gaps;
+  } else if (!std::isnan(gap)) {
+    c.gap = {gap};
+  }
+  if (!std::isnan(theta)) c.theta = theta;
+  if (!loads.empty()) {
+    c.amplitude = loads;
+  } else if (masses != 5) {
+    // The paper's alternating Q = (1, -1, 1, ...) for any number of masses.
+    c.amplitude.clear();
+    for (int i = 0; i < masses; ++i) c.amplitude.push_back(i % 2 == 0 ? 1.0 : -1.0);
+  }
+  return c;
+}
+
+double CaseOptions::step(double period) const {
+  if (dt == 0.0) return period / steps_per_period;
+  if (!(dt > 0.0)) throw InputError(fmt::format("--dt = {} must be positive", dt));
+  const double ratio = period / dt;
+  if (std::abs(ratio - std::round(ratio)) > 1e-9 * ratio) {
+    throw InputError(fmt::format(
+        "--dt = {} does not divide the forcing period {} ({} steps); use --steps-per-period", dt,
+        period, ratio));
+  }
+  return period / std::round(ratio);
+}
+
+std::unique_ptr<Integrator> CaseOptions::integrator(const GapStructure& structure,
+                                                    double period) const {
+  std::unique_ptr<Integrator> result;
+  if (method == "pim" || method == "pim-dense") {
+    PimOptions p;
+    p.step = step(period);
+    p.lcp_solver = lcp_solver;
+    result = method == "pim" ? make_pim_integrator_auto(structure, p)
+                             : make_pim_integrator(structure, p);
+  } else if (method == "pim-banded") {
+    BandedPimOptions b;
+    b.step = step(period);
+    result = make_banded_pim_integrator(structure, b);
+  } else if (method == "pim-switching" || method == "pim-switching-banded") {
+    SwitchingPimOptions s;
+    s.step = step(period);
+    s.lcp_solver = lcp_solver;
+    if (method == "pim-switching-banded" ||
+        (banded_layout(structure).banded && structure.dofs() > 50)) {
+      BandedSwitchingPimOptions b;
+      b.pim = s;
+      result = make_banded_switching_pim(structure, b);
+    } else {
+      result = make_switching_pim(structure, s);
+    }
+  } else if (method == "exact") {
+    result = make_event_driven_solver(structure);
+  } else {
+    ReferenceOptions r;
+    r.method = parse_runge_kutta_method(method);
+    r.relative_tolerance = r.absolute_tolerance = tolerance;
+    r.locate_kinks = locate_kinks;
+    r.max_step = period / 8;
+    result = make_reference_integrator(structure, r);
+  }
+  result->set_state(0.0, Vector::Zero(structure.dofs()), Vector::Zero(structure.dofs()));
+  return result;
+}
+
+}  // namespace pwl::app

@@ -1,0 +1,100 @@
+// pwl map: a two-parameter regime map of the nondimensional chain, classified cell by cell (see
+// analysis/include/pwl/analysis/regime_map.hpp), with a regime heatmap and a λ1 heatmap.
+#include <fmt/format.h>
+
+#include <memory>
+
+#include "commands/commands.hpp"
+#include "output/gnuplot.hpp"
+#include "pwl/study/regime_map.hpp"
+#include "pwl/errors.hpp"
+#include "commands/study_runner.hpp"
+
+namespace pwl::app {
+namespace {
+
+struct MapFlags {
+  ChainFlags chain;
+  PointFlags point;
+  RunFlags run;
+  std::string x = "theta";
+  std::string x_range = "0.5:3";
+  int x_points = 20;
+  std::string y = "alpha";
+  std::string y_range = "1:15";
+  int y_points = 15;
+  std::string mode = "independent";
+  MapFlags() { run.out = "map"; }
+};
+
+analysis::RegimeMapOptions map_options(const MapFlags& f) {
+  analysis::RegimeMapOptions o;
+  o.chain = f.chain.chain();
+  o.first.parameter = analysis::parse_sweep_parameter(f.x);
+  parse_range("--x-range", f.x_range, &o.first.from, &o.first.to);
+  o.first.points = f.x_points;
+  o.second.parameter = analysis::parse_sweep_parameter(f.y);
+  parse_range("--y-range", f.y_range, &o.second.from, &o.second.to);
+  o.second.points = f.y_points;
+  o.mode = f.mode == "continuation" ? analysis::SweepMode::continuation
+                                    : analysis::SweepMode::independent;
+  o.point = f.point.settings(o.chain.masses);
+  o.point.components.clear();
+  std::string why;
+  if (!o.is_valid(&why)) throw InputError(why);
+  return o;
+}
+
+void map(const MapFlags& f) {
+  const analysis::RegimeMapOptions o = map_options(f);
+  Study study = study_of(o);
+  study.finish = [&](const std::map<long, analysis::PointResult>& records) {
+    analysis::write_map_file(o, records, f.run.out);
+    fmt::print("wrote {}/map.csv ({} cells)\n", f.run.out, records.size());
+    if (f.run.no_plot) return;
+    std::string why;
+    const double dx = o.first.points > 1 ? (o.first.to - o.first.from) / (o.first.points - 1) : 1.0;
+    const double dy =
+        o.second.points > 1 ? (o.second.to - o.second.from) / (o.second.points - 1) : 1.0;
+    const auto definitions = [&](const std::string& format) {
+      return fmt::format(
+          "data='{0}/map.csv'; out='{0}/regime_map.{6}'; out_lambda='{0}/lambda1_map.{6}'; "
+          "xname='{1}'; yname='{2}'; dx={3:.17g}; dy={4:.17g}; subtitle={5}",
+          f.run.out, parameter_label(o.first.parameter), parameter_label(o.second.parameter), dx,
+          dy, gnuplot_quoted(study_title(o.chain, o.point)), format);
+    };
+    if (draw_figure(scripts_directory() + "/regime_map.gp", definitions, &why)) {
+      fmt::print("wrote {0}/regime_map.png, {0}/lambda1_map.png and their .svg\n", f.run.out);
+    } else {
+      fmt::print(stderr, "pwl map: no figure: {}\n", why);
+    }
+  };
+  run_study(study, f.run);
+}
+
+}  // namespace
+
+void add_map_command(CLI::App& app) {
+  auto flags = std::make_shared<MapFlags>();
+  CLI::App* c = app.add_subcommand(
+      "map",
+      "Regime map: classify every cell of a two-parameter grid\n"
+      "Example: pwl map --figure 5 --x theta --x-range 0.5:3 --x-points 40 --y alpha \\\n"
+      "           --y-range 1:15 --y-points 29 --out theta_alpha");
+  add_chain_flags(*c, flags->chain);
+  c->add_option("--x", flags->x, "Horizontal parameter: theta, alpha, zeta, gap or amplitude");
+  c->add_option("--x-range", flags->x_range, "FROM:TO of the horizontal parameter");
+  c->add_option("--x-points", flags->x_points, "Values of the horizontal parameter");
+  c->add_option("--y", flags->y, "Vertical parameter");
+  c->add_option("--y-range", flags->y_range, "FROM:TO of the vertical parameter");
+  c->add_option("--y-points", flags->y_points, "Values of the vertical parameter");
+  c->add_option("--mode", flags->mode,
+                "independent (every cell from rest) or continuation (each row upward in the "
+                "horizontal parameter from the previous cell's final state)")
+      ->check(CLI::IsMember({"independent", "continuation"}));
+  add_point_flags(*c, flags->point, false);
+  add_run_flags(*c, flags->run);
+  c->callback([flags] { map(*flags); });
+}
+
+}  // namespace pwl::app

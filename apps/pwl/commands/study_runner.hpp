@@ -1,0 +1,94 @@
+#pragma once
+// What `pwl sweep` and `pwl map` share: the flags of the base chain and of each point, and the
+// driver that runs a study's points into an output folder so that a long run loses nothing.
+//
+// The folder holds config.txt (every setting that changes a result), one journal-<rank>.log per
+// process (a line per finished point, see sweep_journal.hpp) and, once every point is done, the
+// sorted result files. With --resume, a run whose config.txt matches skips the points already
+// in the journals; a different configuration is refused. Without it the folder is started over.
+//
+// Distributed runs (mpirun -np R): task t goes to rank t mod R, each rank spreads its tasks over
+// its OpenMP threads and journals them, and rank 0 gathers every record and writes the files, the
+// same bytes a single process writes. --resume needs the folder on a filesystem every rank sees.
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <limits>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "pwl/study/parameter_grid.hpp"
+#include "pwl/study/sweep_point.hpp"
+
+namespace pwl::app {
+
+// The base chain: a paper preset and flags that override it.
+struct ChainFlags {
+  std::string figure;
+  int masses = 5;
+  std::vector<double> alpha;
+  double zeta = std::numeric_limits<double>::quiet_NaN();
+  double gap = std::numeric_limits<double>::quiet_NaN();
+  double theta = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> loads;
+  NondimensionalChain chain() const;
+};
+void add_chain_flags(CLI::App& command, ChainFlags& flags);
+
+// How each point is integrated and what it keeps.
+struct PointFlags {
+  int transient = 500;
+  int periods = 500;
+  int steps_per_period = 200;
+  std::vector<std::string> record;  // component names: x1..xn, v1..vn
+  bool no_lyapunov = false;
+  analysis::PointSettings settings(int masses) const;  // throws InputError for a bad name
+};
+void add_point_flags(CLI::App& command, PointFlags& flags, bool with_record);
+
+// How the study runs.
+struct RunFlags {
+  std::string out = "sweep";
+  bool resume = false;
+  bool quiet = false;
+  bool no_plot = false;
+  int threads = 0;
+};
+void add_run_flags(CLI::App& command, RunFlags& flags);
+
+struct Study {
+  std::string description;  // config.txt
+  std::vector<analysis::GridTask> tasks;
+  analysis::PointChain chain_of;
+  Vector initial_state;
+  analysis::PointSettings settings;
+  // Called on rank 0 with every record, in id order, once all are done.
+  std::function<void(const std::map<long, analysis::PointResult>&)> finish;
+};
+
+// The study of a sweep or a map: both option types give its description, tasks, chains, start
+// state and point settings the same way.
+template <class GridOptions>
+Study study_of(const GridOptions& o) {
+  Study study;
+  study.description = o.describe();
+  study.tasks = o.tasks();
+  study.chain_of = [o](long id) { return o.chain_of(id); };
+  study.initial_state = o.start_state();
+  study.settings = o.point;
+  return study;
+}
+
+// Runs the study into flags.out. Throws InputError for a resume that does not match.
+void run_study(const Study& study, const RunFlags& flags);
+
+// Parses a range "a:b" into its ends; throws InputError naming the flag otherwise.
+void parse_range(const std::string& flag, const std::string& text, double* from, double* to);
+
+// Figure text: the axis label of a swept parameter ("θ = ω/ω0"), and a title line stating the
+// base case and the integration ("base case: 5 masses, α = 5, ζ = 0.2, Δ̃ = 0, Q = (1,-1,1,-1,1);
+// 300 + 200 periods per point, η = T/200"). Single quotes are left out (gnuplot strings).
+std::string parameter_label(analysis::SweepParameter parameter);
+std::string study_title(const NondimensionalChain& chain, const analysis::PointSettings& point);
+
+}  // namespace pwl::app

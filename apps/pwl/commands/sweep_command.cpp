@@ -1,0 +1,142 @@
+// pwl sweep: a one-parameter sweep of the nondimensional chain, the data and the figure of a
+// bifurcation diagram (see analysis/include/pwl/analysis/parameter_sweep.hpp).
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <memory>
+#include <set>
+
+#include "commands/commands.hpp"
+#include "output/gnuplot.hpp"
+#include "pwl/study/parameter_sweep.hpp"
+#include "pwl/errors.hpp"
+#include "commands/study_runner.hpp"
+
+namespace pwl::app {
+namespace {
+
+struct SweepFlags {
+  ChainFlags chain;
+  PointFlags point;
+  RunFlags run;
+  std::string parameter = "theta";
+  std::string range = "0.5:3";
+  int points = 100;
+  std::string mode = "independent";
+  std::string directions = "both";
+};
+
+analysis::SweepOptions sweep_options(const SweepFlags& f) {
+  analysis::SweepOptions o;
+  o.chain = f.chain.chain();
+  o.parameter = analysis::parse_sweep_parameter(f.parameter);
+  parse_range("--range", f.range, &o.from, &o.to);
+  o.points = f.points;
+  o.mode = f.mode == "continuation" ? analysis::SweepMode::continuation
+                                    : analysis::SweepMode::independent;
+  o.upward = f.directions != "down";
+  o.downward = f.directions != "up";
+  o.point = f.point.settings(o.chain.masses);
+  std::string why;
+  if (!o.is_valid(&why)) throw InputError(why);
+  return o;
+}
+
+// What the bifurcation diagram draws: the first recorded component of every Poincaré point,
+// with the points of one parameter value and direction that fall within 1/1000 of the plotted
+// range of each other (under a pixel) kept once (a periodic orbit's hundreds of returns are a few
+// points), so that the SVG stays small. Same columns as poincare.csv, one component.
+void write_plotted_points(const analysis::SweepOptions& o,
+                          const std::map<long, analysis::PointResult>& records,
+                          const std::string& path) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const auto& [id, r] : records) {
+    for (int k = 0; k < r.rows(); ++k) {
+      const double y =
+          r.poincare[static_cast<std::size_t>(k) * static_cast<std::size_t>(r.columns)];
+      if (std::isfinite(y)) lo = std::min(lo, y), hi = std::max(hi, y);
+    }
+  }
+  const double cell = hi > lo ? (hi - lo) / 1000.0 : 1.0;
+  std::FILE* file = std::fopen(path.c_str(), "w");
+  if (file == nullptr) throw Error(fmt::format("cannot write {}", path));
+  fmt::print(file, "{},direction,index,period_index,value\n",
+             analysis::parameter_name(o.parameter));
+  for (const auto& [id, r] : records) {
+    const int index = static_cast<int>(id % o.points);
+    std::set<long long> seen;
+    for (int k = 0; k < r.rows(); ++k) {
+      const double y =
+          r.poincare[static_cast<std::size_t>(k) * static_cast<std::size_t>(r.columns)];
+      if (!std::isfinite(y) || !seen.insert(std::llround((y - lo) / cell)).second) continue;
+      fmt::print(file, "{:.17g},{},{},{},{:.17g}\n", o.value(index), id < o.points ? "up" : "down",
+                 index, o.point.transient_periods + k + 1, y);
+    }
+  }
+  if (std::fclose(file) != 0) throw Error(fmt::format("cannot finish writing {}", path));
+}
+
+void sweep(const SweepFlags& f) {
+  const analysis::SweepOptions o = sweep_options(f);
+  Study study = study_of(o);
+  study.finish = [&](const std::map<long, analysis::PointResult>& records) {
+    analysis::write_sweep_files(o, records, f.run.out);
+    fmt::print("wrote {0}/poincare.csv and {0}/classification.csv ({1} points)\n", f.run.out,
+               records.size());
+    if (f.run.no_plot) return;
+    write_plotted_points(o, records, f.run.out + "/bifurcation_points.csv");
+    std::string why;
+    const auto definitions = [&](const std::string& format) {
+      return fmt::format(
+          "poincare='{0}/bifurcation_points.csv'; classes='{0}/classification.csv'; "
+          "out='{0}/bifurcation.{4}'; column=5; xname='{1}'; "
+          "yname='{2} at t = kT (nondimensional)'; title={3}",
+          f.run.out, parameter_label(o.parameter),
+          o.point.components.empty()
+              ? std::string("x")
+              : analysis::component_name(o.point.components[0], o.chain.masses),
+          gnuplot_quoted(fmt::format(
+              "pwl sweep of {} ({}): {}", analysis::parameter_name(o.parameter),
+              o.mode == analysis::SweepMode::continuation ? "continuation" : "independent",
+              study_title(o.chain, o.point))),
+          format);
+    };
+    if (draw_figure(scripts_directory() + "/bifurcation.gp", definitions, &why)) {
+      fmt::print("wrote {}/bifurcation.png and .svg\n", f.run.out);
+    } else {
+      fmt::print(stderr, "pwl sweep: no figure: {}\n", why);
+    }
+  };
+  run_study(study, f.run);
+}
+
+}  // namespace
+
+void add_sweep_command(CLI::App& app) {
+  auto flags = std::make_shared<SweepFlags>();
+  CLI::App* c = app.add_subcommand(
+      "sweep",
+      "Bifurcation diagram: Poincaré points and regimes over one parameter\n"
+      "Example: pwl sweep --figure 5 --parameter theta --range 0.5:3 --points 200 \\\n"
+      "           --mode continuation --out theta_sweep");
+  add_chain_flags(*c, flags->chain);
+  c->add_option("--parameter", flags->parameter,
+                "Parameter swept: theta, alpha, zeta, gap (Δ̃) or amplitude (scales Q)");
+  c->add_option("--range", flags->range, "FROM:TO, from < to");
+  c->add_option("--points", flags->points, "Number of parameter values N");
+  c->add_option("--mode", flags->mode,
+                "independent (every point from rest) or continuation (from the previous point's "
+                "final state, upward and downward)")
+      ->check(CLI::IsMember({"independent", "continuation"}));
+  c->add_option("--directions", flags->directions, "Continuation branches: both, up or down")
+      ->check(CLI::IsMember({"both", "up", "down"}));
+  add_point_flags(*c, flags->point, true);
+  add_run_flags(*c, flags->run);
+  c->callback([flags] { sweep(*flags); });
+}
+
+}  // namespace pwl::app

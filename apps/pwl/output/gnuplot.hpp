@@ -1,0 +1,26 @@
+#pragma once
+// Runs the shipped gnuplot scripts. Figures are a by-product: a machine without gnuplot still gets
+// its CSV files, and a warning instead of a failure. Every figure is drawn twice, as PNG and SVG,
+// through plots/terminal.gp, so that both look alike.
+#include <functional>
+#include <string>
+
+#include "output/shipped_files.hpp"
+
+namespace pwl::app {
+
+// Runs `script` after the gnuplot commands `definitions` (variable assignments), with the plots
+// folder on gnuplot's load path. Returns false and fills *why when gnuplot is missing or fails.
+bool run_gnuplot(const std::string& script, const std::string& definitions, std::string* why);
+
+// Draws a figure as PNG and then as SVG: `definitions(format)` gives the variables for "png" or
+// "svg" (its out= names the file with that extension; fmt= is added here).
+bool draw_figure(const std::string& script,
+                 const std::function<std::string(const std::string& format)>& definitions,
+                 std::string* why);
+
+// `text` as a gnuplot single-quoted string literal ('it''s'), for titles and paths.
+std::string gnuplot_quoted(const std::string& text);
+
+
+}  // namespace pwl::app

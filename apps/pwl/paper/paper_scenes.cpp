@@ -1,0 +1,72 @@
+#include "paper/paper_scenes.hpp"
+
+#include <fmt/format.h>
+
+#include <cstdlib>
+
+#include "output/shell_command.hpp"
+
+namespace pwl::app {
+
+
+std::string line_after(const std::string& text, const std::string& prefix) {
+  const std::size_t at = text.find(prefix);
+  if (at == std::string::npos) return "";
+  const std::size_t from = at + prefix.size();
+  return text.substr(from, text.find('\n', from) - from);
+}
+
+const std::vector<ReproducedScene>& reproduced_scenes() {
+  static const std::vector<ReproducedScene> scenes{
+      {"4a",
+       "paper_fig4a.toml",
+       {"output.title=Figure 4a: mass 5, the PIM against a kink-located reference"},
+       {"run.periods=300", "run.skip_periods=200"},
+       {{"comparison", "fig4a"}}},
+      {"4b",
+       "paper_fig4b.toml",
+       {"output.title=Figure 4b: mass 5, the PIM against a kink-located reference"},
+       {"run.periods=300", "run.skip_periods=200"},
+       {{"comparison", "fig4b"}}},
+      {"5",
+       "paper_fig5.toml",
+       {},
+       {"run.periods=400", "analysis.transient=250"},
+       {{"analysis", "analysis_fig5"}}},
+      {"6",
+       "paper_fig6.toml",
+       {},
+       {"run.periods=400", "analysis.transient=250"},
+       {{"analysis", "analysis_fig6"}}},
+      {"7-9",
+       "paper_fig7-9_table1.toml",
+       {},
+       {"structure.masses=200", "method.reference_tol=1e-10", "run.runs=1"},
+       {{"fig7", "fig7"}, {"fig8", "fig8"}, {"fig9", "fig9"}}},
+      {"theta-sweep",
+       "theta_sweep.toml",
+       {},
+       {"sweep.points=12", "run.transient=50", "run.periods=100"},
+       {{"bifurcation", "bifurcation_theta"}}},
+      {"theta-alpha-map",
+       "theta_alpha_map.toml",
+       {},
+       {"map.x_points=5", "map.y_points=4", "run.transient=50", "run.periods=100"},
+       {{"regime_map", "regime_map_theta_alpha"}, {"lambda1_map", "lambda1_map_theta_alpha"}}},
+  };
+  return scenes;
+}
+
+std::string run_scene(const std::string& self, const ReproducedScene& scene, const std::string& out,
+                      bool quick) {
+  std::string command =
+      fmt::format("{} run {} --set output.out={}", shell_quoted(self),
+                  shell_quoted(scenes_directory() + "/" + scene.scene), shell_quoted(out));
+  for (const std::string& s : scene.always) command += " --set " + shell_quoted(s);
+  if (quick) {
+    for (const std::string& s : scene.quick) command += " --set " + shell_quoted(s);
+  }
+  return captured_output(command);
+}
+
+}  // namespace pwl::app

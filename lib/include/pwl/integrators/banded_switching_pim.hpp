@@ -1,0 +1,76 @@
+#pragma once
+// The higher-order precise integration method of switching_pim.hpp with banded operators: the
+// same step (Hermite-Taylor force polynomial, one constant LCP per step, switches located on the
+// Taylor series of the motion), for chain-like structures, with work and memory per smooth step
+// O(n q) instead of O(n²).
+//
+// What is banded, and why it may be. A smooth step of the switching PIM is
+//
+//     v_{k+1} = T v_k + (harmonic responses) + Σ_r C_r p_r + Φ P_{k+1} + S (η P'_{k+1} - guess),
+//
+// with constant operators T = exp(Hη) and C_r, Φ, S, fixed combinations of the scaled moments
+// Ξ̂_r = η^{-r} ∫_0^η e^{H(η-s)} s^r ds G, r = 0..d+2, with G = [0; -M⁻¹W]. For a periodic chain the
+// entries of T fall off faster than exponentially with the distance between degrees of freedom
+// (He, Gao & Zhong 2018, §2; SPEC.md §4), and so do those of every moment: Ξ̂_r [0; I] is a
+// weighted integral of e^{H(η-s)} [0; I] over the step, and the weight s^r only moves it towards
+// the short times, which reach less far. So the moments are read off the same small
+// substructures as T and the linear-load integrals (banded_exponential.hpp, whose rising and
+// falling loads are Ξ̂_1 and Ξ̂_0 - Ξ̂_1): polynomial_force_integrals on each substructure's H
+// with G = [0; I], the step's combinations taken there, and the rows assembled into banded
+// matrices with the band q the banded exponential chose for T. Products with the sparse spring
+// directions (multiply(BandedMatrix, SparseMatrix)) give the 2n x m operators; the LCP matrix
+// I - K2 W^T Φ_x is banded and goes to the banded block-pivoting solver, warm-started from the
+// previous step's active set (banded_lcp_solver.hpp).
+//
+// The rest of the step uses H, W and K2 as sparse matrices: the Taylor recursion that gives the
+// force derivatives p_r (v^{(r+1)} = H v^{(r)} + G P^{(r)} + F^{(r)}) costs O(nnz(H)) = O(n) per
+// term, and the C_r p_r are added from the columns of the touching springs only. A smooth step
+// therefore costs one banded product T v and d + 1 sparse recursion terms, plus O(contacts · q).
+//
+// Switching steps are redone in pieces exactly as in the dense stepper: in each piece the
+// motion is the Taylor series of the current mode about the piece's start, summed to rounding
+// with the sparse H (O(n) per term), the first spring switch is located on the gap polynomials
+// by the safeguarded root search of event_location.hpp, and the next piece starts there. Each
+// piece costs O(n · terms) on the whole state (not restricted to the band around the switching
+// spring).
+//
+// The numbers are those of the dense make_switching_pim up to the band's truncation (the
+// tolerance of BandedExponentialOptions, 1e-15 of each operator block by default) and rounding.
+//
+// References: W. X. Zhong and F. W. Williams, Proc. IMechE C 208 (1994) 427-430 (precise
+// integration); He Dongdong, Gao Qiang and Zhong Wanxie, Appl. Math. Mech. 39(7) (2018) 737-749
+// (the banded exponential of periodic structures); C. F. Van Loan, IEEE TAC 23 (1978) 395-404
+// (integrals of the exponential); M. Hochbruck and A. Ostermann, "Exponential integrators",
+// Acta Numerica 19 (2010) 209-286 (exponential quadrature with polynomial forcing); L. F.
+// Shampine and S. Thompson, Comput. Math. Appl. 39 (2000) 43-54 (event location); E. Hairer,
+// S. P. Nørsett and G. Wanner, Solving ODEs I, §II.6 (steps that straddle a discontinuity lose
+// the order of the method).
+#include <memory>
+#include <string>
+
+#include "pwl/numerics/banded_exponential.hpp"
+#include "pwl/numerics/banded_lcp_solver.hpp"
+#include "pwl/model/gap_structure.hpp"
+#include "pwl/integrators/switching_pim.hpp"
+
+namespace pwl {
+
+struct BandedSwitchingPimOptions {
+  // Step, force degree, end slope, switch location, series limits, divergence bound and the
+  // largest step argument, as for the dense stepper. Its lcp_solver is not used: the banded
+  // stepper always solves its LCP with BandedLcpSolver (`lcp` below).
+  SwitchingPimOptions pim;
+  BandedExponentialOptions band;  // tolerance (or a forced band q), substructures, N
+  BandedLcpOptions lcp;
+  // Ceres-style check: false with a message naming the field (pim.step, band.tolerance, ...)
+  // and its value.
+  bool is_valid(std::string* why) const;
+};
+
+// The banded higher-order PIM. Throws InputError for invalid options or structure (naming the
+// field), a mass matrix that is not diagonal, a step too large for the contact stiffness (as the
+// dense stepper) or no band within the tolerance.
+std::unique_ptr<SwitchingPim> make_banded_switching_pim(const GapStructure& structure,
+                                                        const BandedSwitchingPimOptions& options);
+
+}  // namespace pwl

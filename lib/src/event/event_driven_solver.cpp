@@ -1,0 +1,759 @@
+// The exact event-driven solver (event_driven_solver.hpp): closed-form motion inside each mode,
+// safeguarded event location between modes.
+#include "pwl/integrators/event_driven_solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <unordered_map>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <fmt/format.h>
+
+#include "event/event_location.hpp"
+#include "pwl/errors.hpp"
+
+namespace pwl {
+
+bool EventDrivenOptions::is_valid(std::string* why) const {
+  std::string scratch;
+  if (why == nullptr) why = &scratch;
+  if (representation != "auto" && representation != "modal" && representation != "exponential") {
+    *why = fmt::format("representation = \"{}\" must be \"auto\", \"modal\" or \"exponential\"",
+                       representation);
+    return false;
+  }
+  if (!(max_eigenvector_condition >= 1.0) || !std::isfinite(max_eigenvector_condition)) {
+    *why = fmt::format("max_eigenvector_condition = {} must be finite and >= 1",
+                       max_eigenvector_condition);
+    return false;
+  }
+  if (!(resonance_tolerance >= 0.0) || !(resonance_tolerance < 1.0)) {
+    *why = fmt::format("resonance_tolerance = {} must be in [0, 1)", resonance_tolerance);
+    return false;
+  }
+  if (!(min_relative_width > 0.0) || !(min_relative_width < 1e-3)) {
+    *why = fmt::format("min_relative_width = {} must be in (0, 1e-3)", min_relative_width);
+    return false;
+  }
+  if (!(divergence_bound > 0.0)) {
+    *why = fmt::format("divergence_bound = {} must be positive", divergence_bound);
+    return false;
+  }
+  if (max_events < 1) {
+    *why = fmt::format("max_events = {} must be at least 1", max_events);
+    return false;
+  }
+  return exponential.is_valid(why);
+}
+
+namespace {
+
+using Complex = std::complex<double>;
+using ComplexVector = Eigen::VectorXcd;
+using ComplexMatrix = Eigen::MatrixXcd;
+using event_detail::GapSample;
+
+constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
+constexpr int kBoundOrders = 8;  // derivative orders with precomputed bounds (exponential form)
+
+// What every mode shares: the structure in state-space pieces.
+struct Structure {
+  Index n = 0, m = 0;
+  Matrix stiffness_part;  // -M⁻¹K (n x n)
+  Matrix damping_part;    // -M⁻¹C (n x n)
+  Matrix force_part;      // -M⁻¹W (n x m): velocity rows of the spring-force columns
+  Matrix gap_rows;        // W^T (m x n)
+  Vector gaps;            // Δ
+  Vector stiffnesses;     // k
+  Vector gap_scale;       // |Δ_j| + sum_i |W_ij|: to scale rounding tolerances
+  Matrix abs_gap_rows;    // |W^T|
+  // Load groups in the velocity rows: M⁻¹ times the sin and cos parts, by frequency.
+  std::vector<double> omegas;
+  std::vector<Vector> sin_parts, cos_parts;
+};
+
+// One load frequency of a mode in state space: the forcing Re(β e^{iωt}), β = b_cos - i b_sin.
+struct Term {
+  double omega;
+  ComplexVector beta;  // 2n
+};
+
+// The closed-form representation of one mode.
+class Mode {
+ public:
+  virtual ~Mode() = default;
+  // Prepare to follow the motion from (t0, v0); s holds the mode signs (+1 touching, -1 slack).
+  virtual void start(double t0, const Vector& v0) = 0;
+  virtual void sample(const GapSample& from, double t, GapSample& out) = 0;
+  virtual void state(const GapSample& at, Vector& v) = 0;
+  virtual void derivative_bound(const GapSample& from, double span, int order,
+                                Vector& bound) = 0;
+  virtual void derivatives(const GapSample& at, int max_order, Matrix& d) = 0;
+  virtual double nominal_spacing() const = 0;
+  virtual double response_scale() const = 0;  // size of the particular response's x
+  virtual bool modal() const = 0;
+};
+
+Matrix mode_state_matrix(const Structure& s, const Vector& kmask) {
+  const Index n = s.n;
+  Matrix H = Matrix::Zero(2 * n, 2 * n);
+  H.topRightCorner(n, n).setIdentity();
+  H.bottomLeftCorner(n, n) = s.stiffness_part + s.force_part * kmask.asDiagonal() * s.gap_rows;
+  H.bottomRightCorner(n, n) = s.damping_part;
+  return H;
+}
+
+// The loads of a mode: the structure's groups plus the constant W_A K2_A Δ_A, which joins the
+// ω = 0 group.
+std::vector<Term> mode_terms(const Structure& s, const Vector& kmask) {
+  const Index n = s.n;
+  std::vector<Term> terms;
+  const Vector preload = -s.force_part * kmask.cwiseProduct(s.gaps);  // M⁻¹ W_A K2_A Δ_A
+  bool constant_done = false;
+  for (std::size_t g = 0; g < s.omegas.size(); ++g) {
+    Term t{s.omegas[g], ComplexVector::Zero(2 * n)};
+    t.beta.tail(n) = s.cos_parts[g].cast<Complex>() - Complex(0, 1) * s.sin_parts[g].cast<Complex>();
+    if (s.omegas[g] == 0.0) {
+      t.beta.tail(n) += preload.cast<Complex>();
+      constant_done = true;
+    }
+    terms.push_back(std::move(t));
+  }
+  if (!constant_done && preload.cwiseAbs().maxCoeff() > 0.0) {
+    Term t{0.0, ComplexVector::Zero(2 * n)};
+    t.beta.tail(n) = preload.cast<Complex>();
+    terms.push_back(std::move(t));
+  }
+  return terms;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Modal representation: H_A = V Λ V⁻¹.
+class ModalMode final : public Mode {
+ public:
+  // Returns nullptr (and says why) when the modal form would be inaccurate.
+  static std::unique_ptr<ModalMode> make(const Structure& s, const Vector& kmask,
+                                         const Vector& signs, const EventDrivenOptions& o,
+                                         std::string* why, double* condition) {
+    auto mode = std::unique_ptr<ModalMode>(new ModalMode(s, signs));
+    const Matrix H = mode_state_matrix(s, kmask);
+    Eigen::EigenSolver<Matrix> eig(H, true);
+    if (eig.info() != Eigen::Success) {
+      *why = "the eigenvalue iteration did not converge";
+      return nullptr;
+    }
+    mode->lambda_ = eig.eigenvalues();
+    const ComplexMatrix V = eig.eigenvectors();
+    Eigen::PartialPivLU<ComplexMatrix> lu(V);
+    // cond(V) in the 1-norm, from the LU factors' estimate of the reciprocal condition number.
+    const double rcond = lu.rcond();
+    *condition = rcond > 0.0 ? 1.0 / rcond : std::numeric_limits<double>::infinity();
+    if (!(*condition <= o.max_eigenvector_condition)) {
+      *why = fmt::format("cond(V) = {:.3g} exceeds max_eigenvector_condition = {:.3g} (a "
+                         "defective or nearly defective mode)",
+                         *condition, o.max_eigenvector_condition);
+      return nullptr;
+    }
+    mode->vinv_ = lu.inverse();
+    mode->v_ = V;
+    const Index n = s.n;
+    mode->gap_v_ = s.gap_rows.cast<Complex>() * V.topRows(n);
+    mode->abs_gap_v_ = mode->gap_v_.cwiseAbs();
+    double spectral = 0.0;
+    for (Index k = 0; k < mode->lambda_.size(); ++k) spectral = std::max(spectral, std::abs(mode->lambda_[k]));
+    for (const Term& t : mode_terms(s, kmask)) spectral = std::max(spectral, t.omega);
+    spectral = std::max(spectral, 1e-300);
+    for (const Term& t : mode_terms(s, kmask)) {
+      const ComplexVector bt = mode->vinv_ * t.beta;
+      const double size = bt.cwiseAbs().maxCoeff();
+      ModalTerm mt{t.omega, ComplexVector(bt.size()), ComplexVector(), ComplexVector(), Vector()};
+      for (Index k = 0; k < bt.size(); ++k) {
+        const Complex gap = Complex(0.0, t.omega) - mode->lambda_[k];
+        if (std::abs(gap) <= o.resonance_tolerance * spectral &&
+            std::abs(bt[k]) > 1e-14 * size) {
+          *why = fmt::format("the load at ω = {} is resonant with the mode λ = {}{:+}i", t.omega,
+                             mode->lambda_[k].real(), mode->lambda_[k].imag());
+          return nullptr;
+        }
+        // A component forced at rounding level only, exactly at resonance, is left unforced.
+        mt.modal[k] = std::abs(bt[k]) > 1e-14 * size && std::abs(gap) > 0.0 ? bt[k] / gap
+                                                                           : Complex(0.0);
+      }
+      mt.state = V * mt.modal;
+      mt.gap = mode->gap_v_ * mt.modal;
+      mt.abs_gap = mt.gap.cwiseAbs();
+      mode->response_scale_ += mt.state.head(n).cwiseAbs().maxCoeff();
+      mode->terms_.push_back(std::move(mt));
+    }
+    mode->spacing_ = 0.25 * M_PI / spectral;
+    mode->extend_powers(8);
+    for (Index k = 0; k < mode->lambda_.size(); ++k) {
+      mode->unstable_ = mode->unstable_ || mode->lambda_[k].real() > 0.0;
+    }
+    return mode;
+  }
+
+  void start(double t0, const Vector& v0) override {
+    t0_ = t0;
+    c_ = vinv_ * v0.cast<Complex>();
+    for (const ModalTerm& t : terms_) c_ -= t.modal * std::polar(1.0, t.omega * t0);
+  }
+
+  void sample(const GapSample&, double t, GapSample& out) override {
+    out.t = t;
+    z_ = c_.cwiseProduct((lambda_ * (t - t0_)).array().exp().matrix());
+    lz_ = lambda_.cwiseProduct(z_);
+    llz_ = lambda_.cwiseProduct(lz_);
+    g_.noalias() = (gap_v_ * z_).real();
+    r_.noalias() = (gap_v_ * lz_).real();
+    a_.noalias() = (gap_v_ * llz_).real();
+    for (const ModalTerm& term : terms_) {
+      const Complex phase = std::polar(1.0, term.omega * t);
+      const Complex iw(0.0, term.omega);
+      g_ += (term.gap * phase).real();
+      r_ += (term.gap * (iw * phase)).real();
+      a_ += (term.gap * (iw * iw * phase)).real();
+    }
+    out.e = signs_.cwiseProduct(g_ - s_.gaps);
+    out.rate = signs_.cwiseProduct(r_);
+    out.accel = signs_.cwiseProduct(a_);
+    // |c_k e^{λ_k τ}|: the size of each modal term now (no overflow guard needed at these sizes).
+    out.carry = (z_.real().array().square() + z_.imag().array().square()).sqrt().matrix();
+  }
+
+  void state(const GapSample& at, Vector& v) override {
+    z_ = c_.cwiseProduct((lambda_ * (at.t - t0_)).array().exp().matrix());
+    v = (v_ * z_).real();
+    for (const ModalTerm& term : terms_) v += (term.state * std::polar(1.0, term.omega * at.t)).real();
+  }
+
+  void derivative_bound(const GapSample& from, double span, int order, Vector& bound) override {
+    // Each modal term c_k e^{λ_k τ} λ_k^r has size |z_k| |λ_k|^r at `from`, no more later when
+    // Re λ_k <= 0, and at most e^{Re λ_k span} times more otherwise.
+    if (order >= static_cast<int>(powers_.cols())) extend_powers(order);
+    weights_ = from.carry.cwiseProduct(powers_.col(order));
+    if (unstable_) {
+      for (Index k = 0; k < lambda_.size(); ++k) {
+        const double re = lambda_[k].real();
+        if (re > 0.0) weights_[k] *= std::exp(re * span);
+      }
+    }
+    bound.noalias() = abs_gap_v_ * weights_;
+    for (const ModalTerm& term : terms_) {
+      if (term.omega == 0.0 && order > 0) continue;
+      bound += std::pow(term.omega, order) * term.abs_gap;
+    }
+  }
+
+  void derivatives(const GapSample& at, int max_order, Matrix& d) override {
+    d.resize(s_.m, max_order + 1);
+    z_ = c_.cwiseProduct((lambda_ * (at.t - t0_)).array().exp().matrix());
+    std::vector<Complex> factor;
+    for (const ModalTerm& term : terms_) factor.push_back(std::polar(1.0, term.omega * at.t));
+    for (int r = 0; r <= max_order; ++r) {
+      Vector g = (gap_v_ * z_).real();
+      for (std::size_t i = 0; i < terms_.size(); ++i) {
+        g += (terms_[i].gap * factor[i]).real();
+        factor[i] *= Complex(0.0, terms_[i].omega);  // (iω)^r e^{iωt}
+      }
+      if (r == 0) g -= s_.gaps;
+      d.col(r) = signs_.cwiseProduct(g);
+      z_ = lambda_.cwiseProduct(z_);
+    }
+  }
+
+  double nominal_spacing() const override { return spacing_; }
+  double response_scale() const override { return response_scale_; }
+  bool modal() const override { return true; }
+
+ private:
+  struct ModalTerm {
+    double omega;
+    ComplexVector modal;  // β̃ / (iω - λ): the particular response in modal coordinates
+    ComplexVector state;  // V times that
+    ComplexVector gap;    // W^T times its displacement rows
+    Vector abs_gap;       // |gap|
+  };
+
+  // powers_(k, r) = |λ_k|^r
+  void extend_powers(int order) {
+    const Index old = powers_.cols();
+    powers_.conservativeResize(lambda_.size(), order + 1);
+    for (Index r = std::max<Index>(old, 0); r <= order; ++r) {
+      for (Index k = 0; k < lambda_.size(); ++k) {
+        powers_(k, r) = std::pow(std::abs(lambda_[k]), static_cast<double>(r));
+      }
+    }
+  }
+
+  ModalMode(const Structure& s, const Vector& signs) : s_(s), signs_(signs) {}
+
+  const Structure& s_;
+  Vector signs_;
+  ComplexVector lambda_;
+  ComplexMatrix v_, vinv_, gap_v_;
+  Matrix abs_gap_v_;
+  std::vector<ModalTerm> terms_;
+  double spacing_ = 1.0;
+  double response_scale_ = 0.0;
+  bool unstable_ = false;
+  Matrix powers_;
+  double t0_ = 0.0;
+  ComplexVector c_, z_, lz_, llz_;
+  Vector g_, r_, a_, weights_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Augmented-exponential representation: w = [v; sin ω_g t, cos ω_g t ...; 1], w' = Ĥ w.
+class ExponentialMode final : public Mode {
+ public:
+  ExponentialMode(const Structure& s, const Vector& kmask, const Vector& signs,
+                  const PreciseExponentialOptions& exponential)
+      : s_(s), signs_(signs), exponential_(exponential) {
+    const Index n = s.n;
+    const std::vector<Term> terms = mode_terms(s, kmask);
+    for (const Term& t : terms) {
+      if (t.omega > 0.0) omegas_.push_back(t.omega);
+    }
+    const Index q = static_cast<Index>(omegas_.size());
+    size_ = 2 * n + 2 * q + 1;
+    const Index one = size_ - 1;
+    Matrix Hh = Matrix::Zero(size_, size_);
+    Hh.topLeftCorner(2 * n, 2 * n) = mode_state_matrix(s, kmask);
+    Index g = 0;
+    for (const Term& t : terms) {
+      if (t.omega == 0.0) {
+        Hh.col(one).head(2 * n) += t.beta.real();
+        continue;
+      }
+      const Index si = 2 * n + 2 * g, ci = si + 1;
+      Hh.col(si).head(2 * n) = -t.beta.imag();  // sin part: β = b_cos - i b_sin
+      Hh.col(ci).head(2 * n) = t.beta.real();
+      Hh(si, ci) = t.omega;
+      Hh(ci, si) = -t.omega;
+      ++g;
+    }
+    h_ = Hh;
+    // Logarithmic 2-norm: ||exp(Ĥ u)|| <= exp(μ u).
+    Eigen::SelfAdjointEigenSolver<Matrix> sym(0.5 * (Hh + Hh.transpose()), Eigen::EigenvaluesOnly);
+    log_norm_ = std::max(0.0, sym.eigenvalues().maxCoeff());
+    // Rows whose product with w is W^T times the displacement rows of Ĥ^r w.
+    Matrix rows = Matrix::Zero(s.m, size_);
+    rows.leftCols(n) = s.gap_rows;
+    row_norms_.resize(s.m, kBoundOrders + 1);
+    for (int r = 0; r <= kBoundOrders; ++r) {
+      row_norms_.col(r) = rows.rowwise().norm();
+      rows = rows * Hh;
+    }
+    const double norm = Hh.topLeftCorner(2 * n, 2 * n).lpNorm<Eigen::Infinity>();
+    double w_max = 0.0;
+    for (double w : omegas_) w_max = std::max(w_max, w);
+    spacing_ = 0.5 / std::max({norm, w_max, 1e-300});
+  }
+
+  void start(double t0, const Vector& v0) override {
+    const Index n = s_.n;
+    w0_.setZero(size_);
+    w0_.head(2 * n) = v0;
+    for (std::size_t g = 0; g < omegas_.size(); ++g) {
+      w0_[2 * n + 2 * static_cast<Index>(g)] = std::sin(omegas_[g] * t0);
+      w0_[2 * n + 2 * static_cast<Index>(g) + 1] = std::cos(omegas_[g] * t0);
+    }
+    w0_[size_ - 1] = 1.0;
+    t0_ = t0;
+  }
+
+  void sample(const GapSample& from, double t, GapSample& out) override {
+    const Vector& w = from.carry.size() == size_ ? from.carry : w0_;
+    const double t_from = from.carry.size() == size_ ? from.t : t0_;
+    const double delta = t - t_from;
+    out.t = t;
+    out.carry = delta == 0.0 ? w : Vector(exponential(delta) * w);
+    const Index n = s_.n;
+    out.e = signs_.cwiseProduct(s_.gap_rows * out.carry.head(n) - s_.gaps);
+    out.rate = signs_.cwiseProduct(s_.gap_rows * out.carry.segment(n, n));
+    out.accel = signs_.cwiseProduct(s_.gap_rows * (h_.middleRows(n, n) * out.carry));
+  }
+
+  void state(const GapSample& at, Vector& v) override { v = at.carry.head(2 * s_.n); }
+
+  void derivative_bound(const GapSample& from, double span, int order, Vector& bound) override {
+    const Vector& w = from.carry.size() == size_ ? from.carry : w0_;
+    const double growth = std::exp(log_norm_ * span) * w.norm();
+    if (order <= kBoundOrders) {
+      bound = row_norms_.col(order) * growth;
+    } else {
+      // ||Ĥ^r|| <= ||Ĥ||^(r - kBoundOrders) times the stored rows.
+      bound = row_norms_.col(kBoundOrders) * growth *
+              std::pow(h_.norm(), order - kBoundOrders);
+    }
+  }
+
+  void derivatives(const GapSample& at, int max_order, Matrix& d) override {
+    d.resize(s_.m, max_order + 1);
+    Vector u = at.carry;
+    for (int r = 0; r <= max_order; ++r) {
+      Vector g = s_.gap_rows * u.head(s_.n);
+      if (r == 0) g -= s_.gaps;
+      d.col(r) = signs_.cwiseProduct(g);
+      u = h_ * u;
+    }
+  }
+
+  double nominal_spacing() const override { return spacing_; }
+  double response_scale() const override { return 0.0; }
+  bool modal() const override { return false; }
+  const Vector& start_state() const { return w0_; }
+  double start_time() const { return t0_; }
+
+ private:
+  const Matrix& exponential(double delta) {
+    auto it = cache_.find(delta);
+    if (it != cache_.end()) return it->second;
+    if (cache_.size() > 256) cache_.clear();
+    Matrix E;
+    if (delta > 0.0) {
+      E = precise_exponential(h_, delta, exponential_);
+    } else {
+      // Backwards (only ever by rounding amounts): exp(Ĥδ) = exp((-Ĥ)|δ|).
+      E = precise_exponential(Matrix(-h_), -delta, exponential_);
+    }
+    return cache_.emplace(delta, std::move(E)).first->second;
+  }
+
+  const Structure& s_;
+  Vector signs_;
+  PreciseExponentialOptions exponential_;
+  std::vector<double> omegas_;
+  Index size_ = 0;
+  Matrix h_;
+  double log_norm_ = 0.0;
+  Matrix row_norms_;
+  double spacing_ = 1.0;
+  Vector w0_;
+  double t0_ = 0.0;
+  std::map<double, Matrix> cache_;
+};
+
+// The current mode's gap functions for the event search.
+class CurrentGaps final : public event_detail::ModeGaps {
+ public:
+  Mode* mode = nullptr;
+  Index m = 0;
+  Index springs() const override { return m; }
+  void sample(const GapSample& from, double t, GapSample& out) override {
+    mode->sample(from, t, out);
+  }
+  void derivative_bound(const GapSample& from, double span, int order, Vector& bound) override {
+    mode->derivative_bound(from, span, order, bound);
+  }
+  void derivatives(const GapSample& at, int max_order, Matrix& d) override {
+    mode->derivatives(at, max_order, d);
+  }
+};
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+struct EventDrivenSolver::Impl {
+  EventDrivenOptions options;
+  Structure s;
+  std::unordered_map<std::uint64_t, std::unique_ptr<Mode>> modes;
+  EventDrivenDiagnostics diagnostics;
+  IntegratorStats stats;
+  EventObserver event_observer;
+
+  std::uint64_t mask = 0;
+  Vector signs;  // +1 touching, -1 slack
+  Mode* mode = nullptr;
+  CurrentGaps gaps;
+  event_detail::EventLocator locator;
+  GapSample now;
+  double t = 0.0;
+  Vector x, v, state;
+  Vector certified_until;
+  std::vector<bool> resting;
+  double x_scale = 0.0;
+
+  Mode* mode_for(std::uint64_t active) {
+    auto it = modes.find(active);
+    if (it != modes.end()) return it->second.get();
+    Vector kmask(s.m), sg(s.m);
+    for (Index j = 0; j < s.m; ++j) {
+      const bool on = (active >> j) & 1u;
+      kmask[j] = on ? s.stiffnesses[j] : 0.0;
+      sg[j] = on ? 1.0 : -1.0;
+    }
+    std::unique_ptr<Mode> made;
+    if (options.representation != "exponential") {
+      std::string why;
+      double condition = 0.0;
+      made = ModalMode::make(s, kmask, sg, options, &why, &condition);
+      if (made) {
+        ++diagnostics.modal_modes;
+        diagnostics.worst_condition = std::max(diagnostics.worst_condition, condition);
+      } else if (options.representation == "modal") {
+        throw InputError(fmt::format("representation = \"modal\": the mode with active set {:#x} "
+                                     "cannot be represented modally: {}",
+                                     active, why));
+      }
+    }
+    if (!made) {
+      made = std::make_unique<ExponentialMode>(s, kmask, sg, options.exponential);
+      ++diagnostics.exponential_modes;
+    }
+    return modes.emplace(active, std::move(made)).first->second.get();
+  }
+
+  // Rounding tolerances on the mode-signed gaps. Zero (a crossing is a sign change) except for
+  // springs found resting on their kink (no significant derivative), which would otherwise
+  // raise events at every rounding-level sign flip.
+  Vector tolerances() const {
+    Vector tol = Vector::Zero(s.m);
+    for (Index j = 0; j < s.m; ++j) {
+      if (!resting[static_cast<std::size_t>(j)]) continue;
+      tol[j] = 256.0 * kEpsilon * (std::abs(s.gaps[j]) + s.abs_gap_rows.row(j).dot(x.cwiseAbs()) +
+                                   s.gap_scale[j] * x_scale);
+    }
+    return tol;
+  }
+
+  // Enters the mode of `mask` at time t with state `state`.
+  void enter(double time) {
+    mode = mode_for(mask);
+    for (Index j = 0; j < s.m; ++j) signs[j] = ((mask >> j) & 1u) ? 1.0 : -1.0;
+    mode->start(time, state);
+    gaps.mode = mode;
+    now = GapSample();
+    now.t = time;
+    mode->sample(now, time, now);
+    x_scale = std::max({x_scale, x.cwiseAbs().maxCoeff(), mode->response_scale()});
+  }
+
+  void set_bit(Index j, bool on) {
+    if (on) {
+      mask |= (std::uint64_t{1} << j);
+    } else {
+      mask &= ~(std::uint64_t{1} << j);
+    }
+  }
+
+  // Springs on (or within rounding of) their kink at the current time get the mode their
+  // leading derivatives point to, and a certified departure time.
+  // A spring whose first significant derivative points back (it only touched its kink) is
+  // flipped back and certified again in the mode it came from.
+  void settle(const std::vector<Index>& springs) {
+    for (Index j : springs) resting[static_cast<std::size_t>(j)] = false;
+    for (int pass = 0; pass < 3; ++pass) {
+      const Vector tol = tolerances();
+      bool flipped = false;
+      for (Index j : springs) {
+        double until = t;
+        const int verdict = locator.certify_departure(gaps, now, j, tol[j],
+                                                            mode->nominal_spacing(),
+                                                            min_width(t), &until);
+        if (verdict < 0) {
+          set_bit(j, !((mask >> j) & 1u));
+          flipped = true;
+        } else {
+          certified_until[j] = until;
+          resting[static_cast<std::size_t>(j)] = verdict == 0;
+        }
+      }
+      if (!flipped) return;
+      enter(t);
+    }
+  }
+
+  double min_width(double time) const {
+    return options.min_relative_width * std::max(std::abs(time), 1.0);
+  }
+
+  void sync_state() {
+    x = state.head(s.n);
+    v = state.tail(s.n);
+  }
+
+  void check(double time) const {
+    const double largest = state.cwiseAbs().maxCoeff();
+    if (!(largest <= options.divergence_bound)) {
+      throw DivergenceError(fmt::format(
+          "event-driven solver: the motion blew up at t = {}: largest |x| or |x'| is {} "
+          "(divergence_bound {})",
+          time, largest, options.divergence_bound));
+    }
+  }
+};
+
+EventDrivenSolver::EventDrivenSolver(const GapStructure& structure,
+                                     const EventDrivenOptions& options)
+    : impl_(std::make_unique<Impl>()) {
+  structure.validate();
+  std::string why;
+  if (!options.is_valid(&why)) throw InputError("event-driven solver options: " + why);
+  if (structure.spring_count() > 62) {
+    throw InputError(fmt::format("springs = {}: the event-driven solver handles at most 62 gap "
+                                 "springs (its modes are keyed by a 64-bit active set)",
+                                 structure.spring_count()));
+  }
+  Impl& p = *impl_;
+  p.options = options;
+  Structure& s = p.s;
+  s.n = structure.dofs();
+  s.m = structure.spring_count();
+  const Eigen::LLT<Matrix> mass{Matrix(structure.mass)};
+  s.stiffness_part = -mass.solve(Matrix(structure.stiffness));
+  s.damping_part = -mass.solve(Matrix(structure.damping));
+  const Matrix W = structure.spring_directions();
+  s.force_part = s.m > 0 ? Matrix(-mass.solve(W)) : Matrix(s.n, 0);
+  s.gap_rows = W.transpose();
+  s.abs_gap_rows = s.gap_rows.cwiseAbs();
+  s.gaps = structure.spring_gaps();
+  s.stiffnesses = structure.spring_stiffnesses();
+  s.gap_scale.resize(s.m);
+  for (Index j = 0; j < s.m; ++j) s.gap_scale[j] = s.abs_gap_rows.row(j).sum();
+  for (const LoadGroup& g : structure.load_groups()) {
+    s.omegas.push_back(g.omega);
+    s.sin_parts.push_back(mass.solve(g.sin_part));
+    s.cos_parts.push_back(mass.solve(g.cos_part));
+  }
+  p.signs = Vector::Constant(s.m, -1.0);
+  p.certified_until = Vector::Constant(s.m, -std::numeric_limits<double>::infinity());
+  p.resting.assign(static_cast<std::size_t>(s.m), false);
+  p.gaps.m = s.m;
+  set_state(0.0, Vector::Zero(s.n), Vector::Zero(s.n));
+}
+
+EventDrivenSolver::~EventDrivenSolver() = default;
+
+std::string EventDrivenSolver::name() const {
+  const auto& o = impl_->options;
+  return fmt::format("exact event-driven ({})", o.representation);
+}
+
+Index EventDrivenSolver::dofs() const { return impl_->s.n; }
+
+void EventDrivenSolver::set_state(double t, const Vector& x, const Vector& v) {
+  Impl& p = *impl_;
+  const Index n = p.s.n;
+  if (x.size() != n || v.size() != n) {
+    throw InputError(fmt::format("set_state: x has size {} and v has size {}; both must be {}",
+                                 x.size(), v.size(), n));
+  }
+  if (!std::isfinite(t) || !x.allFinite() || !v.allFinite()) {
+    throw InputError(fmt::format("set_state: the state at t = {} has a non-finite entry", t));
+  }
+  p.t = t;
+  p.state.resize(2 * n);
+  p.state << x, v;
+  p.sync_state();
+  p.x_scale = 0.0;
+  p.certified_until.setConstant(-std::numeric_limits<double>::infinity());
+  // Springs clearly open or closed take that mode; those within rounding of their kink start
+  // slack and are settled by their derivatives.
+  const Vector g = p.s.gap_rows * x - p.s.gaps;
+  p.x_scale = x.cwiseAbs().maxCoeff();
+  std::fill(p.resting.begin(), p.resting.end(), true);
+  const Vector tol = p.tolerances();
+  std::fill(p.resting.begin(), p.resting.end(), false);
+  p.mask = 0;
+  std::vector<Index> on_kink;
+  for (Index j = 0; j < p.s.m; ++j) {
+    if (g[j] > tol[j]) p.set_bit(j, true);
+    if (std::abs(g[j]) <= tol[j]) on_kink.push_back(j);
+  }
+  p.enter(t);
+  p.settle(on_kink);
+}
+
+double EventDrivenSolver::time() const { return impl_->t; }
+const Vector& EventDrivenSolver::position() const { return impl_->x; }
+const Vector& EventDrivenSolver::velocity() const { return impl_->v; }
+
+void EventDrivenSolver::advance_to(double t_end, const StepObserver& observer) {
+  Impl& p = *impl_;
+  if (!std::isfinite(t_end) || t_end < p.t) {
+    throw InputError(fmt::format("event-driven solver: advance_to(t_end = {}) must be finite and "
+                                 "not before the current time {}",
+                                 t_end, p.t));
+  }
+  long events = 0;
+  event_detail::SearchSettings settings;
+  while (true) {
+    settings.nominal_spacing = p.mode->nominal_spacing();
+    settings.min_width = p.min_width(t_end);
+    settings.tolerance = p.tolerances();
+    settings.certified_until = p.certified_until;
+    const event_detail::SearchResult& r = p.locator.find_first_crossing(p.gaps, p.now, t_end, settings);
+    p.diagnostics.gap_samples += r.samples;
+    p.diagnostics.uncertified += r.uncertified;
+    p.mode->state(r.at, p.state);
+    p.t = r.at.t;
+    p.sync_state();
+    p.check(p.t);
+    if (!r.found) {
+      p.now = r.at;
+      p.t = t_end;
+      ++p.stats.steps;
+      if (observer) observer(p.t, p.x, p.v);
+      return;
+    }
+    if (++events > p.options.max_events) {
+      throw DivergenceError(fmt::format(
+          "event-driven solver: more than max_events = {} switches before t_end = {} (stuck at "
+          "t = {:.17g}: a Zeno or chattering motion)",
+          p.options.max_events, t_end, p.t));
+    }
+    for (Index j : r.springs) p.set_bit(j, !((p.mask >> j) & 1u));
+    p.enter(p.t);
+    // Springs leaving their kink now, and those still inside an earlier departure window (the
+    // switch changed the forces they feel), are certified again in the new mode.
+    const std::vector<Index> switched = r.springs;  // r is overwritten by the next search
+    std::vector<Index> settle = switched;
+    for (Index j = 0; j < p.s.m; ++j) {
+      if (p.certified_until[j] > p.t && std::find(settle.begin(), settle.end(), j) == settle.end()) {
+        settle.push_back(j);
+      }
+    }
+    const std::uint64_t before = p.mask;
+    p.settle(settle);
+    for (Index j : switched) {
+      const bool on = (p.mask >> j) & 1u;
+      if (on == (((before >> j) & 1u) != 0)) {
+        ++p.diagnostics.events;
+        ++p.stats.kink_events;
+        if (p.event_observer) p.event_observer(p.t, j, on);
+      }
+    }
+    ++p.stats.steps;
+    if (observer) observer(p.t, p.x, p.v);
+  }
+}
+
+IntegratorStats EventDrivenSolver::stats() const { return impl_->stats; }
+EventDrivenDiagnostics EventDrivenSolver::diagnostics() const { return impl_->diagnostics; }
+
+bool EventDrivenSolver::touching(Index spring) const {
+  if (spring < 0 || spring >= impl_->s.m) {
+    throw InputError(fmt::format("touching(spring = {}): springs are numbered 0..{}", spring,
+                                 impl_->s.m - 1));
+  }
+  return (impl_->mask >> spring) & 1u;
+}
+
+void EventDrivenSolver::set_event_observer(EventObserver observer) {
+  impl_->event_observer = std::move(observer);
+}
+
+std::unique_ptr<Integrator> make_event_driven_solver(const GapStructure& structure,
+                                                     const EventDrivenOptions& options) {
+  return std::make_unique<EventDrivenSolver>(structure, options);
+}
+
+}  // namespace pwl

@@ -1,0 +1,474 @@
+// Banded LCP solver: block principal pivoting (Júdice & Pires, Computers & Operations Research
+// 21 (1994) 587-596) with Murty's single principal pivoting as the fall-back (Murty, Opsearch 11
+// (1974) 123-130), on active-set systems solved in O(size · bandwidth): Gauss-Seidel for a
+// diagonally dominant matrix, a band LU without pivoting otherwise (positive pivots on a
+// P-matrix: Cottle, Pang & Stone, The Linear Complementarity Problem, 1992, §3.3).
+#include "pwl/numerics/banded_lcp_solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "pwl/errors.hpp"
+
+namespace pwl {
+namespace {
+
+// As in the dense solver: entries of the complementary basic vector down to -kFeasTol |q|_inf
+// count as non-negative; pivots of M_AA below kSingularTol · width · max|M| mean singular.
+constexpr double kFeasTol = 1e-11;
+constexpr double kSingularTol = 1e-13;
+// Non-improving block iterations before Murty's rule.
+constexpr int kBlockTries = 3;
+// Gauss-Seidel stops when a sweep moves no force by more than this fraction of the largest (a
+// few units of rounding: the remaining error is at most dominance / (1 - dominance) times it).
+constexpr double kSweepTol = 4.0 * std::numeric_limits<double>::epsilon();
+
+double row_dot(const BandedMatrix& M, Index i, const double* z) {
+  const double* a = M.row_values(i);
+  const double* x = z + M.first_column(i);
+  double s0 = 0.0, s1 = 0.0;
+  const Index w = M.width();
+  Index k = 0;
+  for (; k + 2 <= w; k += 2) {
+    s0 += a[k] * x[k];
+    s1 += a[k + 1] * x[k + 1];
+  }
+  if (k < w) s0 += a[k] * x[k];
+  return s0 + s1;
+}
+
+}  // namespace
+
+bool BandedLcpOptions::is_valid(std::string* why) const {
+  std::string scratch;
+  if (why == nullptr) why = &scratch;
+  if (!(dominance_limit >= 0.0 && dominance_limit < 1.0)) {
+    *why = fmt::format("dominance_limit = {} must be in [0, 1)", dominance_limit);
+    return false;
+  }
+  if (max_sweeps < 1) {
+    *why = fmt::format("max_sweeps = {} must be at least 1", max_sweeps);
+    return false;
+  }
+  return true;
+}
+
+BandedLcpSolver::BandedLcpSolver(const BandedLcpOptions& options) : options_(options) {
+  std::string why;
+  if (!options_.is_valid(&why)) throw InputError("banded LCP options: " + why);
+}
+
+void BandedLcpSolver::set_matrix(const Matrix& M) {
+  if (M.rows() != M.cols()) {
+    throw InputError(fmt::format("banded LCP: set_matrix: M is {}x{}; it must be square",
+                                 M.rows(), M.cols()));
+  }
+  set_matrix(BandedMatrix::from_dense_nonzeros(M));
+}
+
+void BandedLcpSolver::set_matrix(const BandedMatrix& M) {
+  if (M.rows() != M.cols()) {
+    throw InputError(fmt::format("banded LCP: set_matrix: M is {}x{}; it must be square",
+                                 M.rows(), M.cols()));
+  }
+  const Index n = M.rows();
+  M_ = M;
+  scale_ = 0.0;
+  diagonal_.resize(n);
+  dominance_ = 0.0;
+  for (Index i = 0; i < n; ++i) {
+    const double* a = M_.row_values(i);
+    double off = 0.0;
+    for (Index k = 0; k < M_.width(); ++k) {
+      if (!std::isfinite(a[k])) {
+        throw InputError(fmt::format("banded LCP: set_matrix: M({},{}) = {} is not finite", i,
+                                     M_.first_column(i) + k, a[k]));
+      }
+      scale_ = std::max(scale_, std::abs(a[k]));
+      if (M_.first_column(i) + k != i) off += std::abs(a[k]);
+    }
+    diagonal_[i] = M_.coeff(i, i);
+    dominance_ = diagonal_[i] > 0.0 ? std::max(dominance_, off / diagonal_[i])
+                                    : std::numeric_limits<double>::infinity();
+  }
+  if (scale_ == 0.0) scale_ = 1.0;
+  iterate_ = dominance_ <= options_.dominance_limit;
+  lower_ = M_.lower_bandwidth();
+  upper_ = M_.upper_bandwidth();
+  columns_ = transpose(M_);
+  const auto size = static_cast<std::size_t>(n);
+  lu_.assign(size * static_cast<std::size_t>(lower_ + upper_ + 1), 0.0);
+  rhs_.assign(size, 0.0);
+  active_.assign(size, 0);
+  set_.clear();
+  set_.reserve(size);
+  factored_.clear();
+  factored_.reserve(size);
+  x_.setZero(n);
+  scratch_.assign(size, 0.0);
+  seen_.assign(size, 0);
+  // As in the dense solver: generous for any P-matrix problem; guards against bugs and
+  // breakdown.
+  max_iterations_ = 50L * (n + 1) * std::min<long>(n + 1, 1000);
+  has_matrix_ = true;
+}
+
+LcpResult BandedLcpSolver::solve(const Eigen::Ref<const Vector>& q, Eigen::Ref<Vector> z,
+                                 Eigen::Ref<Vector> w) {
+  if (!has_matrix_) throw InputError("banded LCP: solve called before set_matrix");
+  const Index n = M_.rows();
+  if (q.size() != n || z.size() != n || w.size() != n) {
+    throw InputError(fmt::format(
+        "banded LCP: solve: q, z and w have sizes {}, {} and {}; expected {} (the size of M)",
+        q.size(), z.size(), w.size(), n));
+  }
+  double qmax = 0.0, qmin = n > 0 ? std::numeric_limits<double>::infinity() : 0.0;
+  for (Index i = 0; i < n; ++i) {
+    if (!std::isfinite(q[i])) {
+      throw InputError(fmt::format("banded LCP: solve: q[{}] = {} is not finite", i, q[i]));
+    }
+    qmax = std::max(qmax, std::abs(q[i]));
+    qmin = std::min(qmin, q[i]);
+  }
+  LcpResult result;
+  const double tol_w = kFeasTol * qmax;
+  const double tol_z = tol_w / scale_;
+  if (qmin >= -tol_w) {  // z = 0 solves it
+    z.setZero();
+    for (Index i = 0; i < n; ++i) w[i] = std::max(q[i], 0.0);
+    return result;
+  }
+
+  // z doubles as the iterate: its entries on the active set are the warm start of Gauss-Seidel,
+  // zeros elsewhere.
+  for (Index i = 0; i < n; ++i) {
+    active_[static_cast<std::size_t>(i)] = z[i] > 0.0 ? 1 : 0;
+    if (!(z[i] > 0.0)) z[i] = 0.0;
+  }
+  double* zd = z.data();
+  int best_count = static_cast<int>(n) + 1;
+  int tries = kBlockTries;
+  for (long iter = 0;; ++iter) {
+    if (iter >= max_iterations_) {
+      throw LcpError(fmt::format(
+          "banded block pivoting: no solution after {} iterations (n = {}), the iteration limit "
+          "(M is not a P-matrix?)",
+          iter, n));
+    }
+    set_.clear();
+    for (Index i = 0; i < n; ++i) {
+      if (active_[static_cast<std::size_t>(i)]) set_.push_back(static_cast<int>(i));
+    }
+    solve_active(q, zd);
+    // w = q + M z from the columns of the active forces only (z is zero elsewhere).
+    x_ = q;
+    columns_.transpose_multiply_add(zd, x_.data());
+    int count = 0;
+    Index last = -1;
+    for (Index i = 0; i < n; ++i) {
+      const bool in = active_[static_cast<std::size_t>(i)] != 0;
+      if (in) x_[i] = zd[i];
+      if (x_[i] < -(in ? tol_z : tol_w)) {
+        ++count;
+        last = i;
+      }
+    }
+    if (count == 0) break;
+    const auto flip = [&](Index i) {
+      unsigned char& a = active_[static_cast<std::size_t>(i)];
+      a ^= 1;
+      // A force that enters starts from the value that zeroes its own slack; one that leaves is 0.
+      zd[i] = a ? -q[i] / diagonal_[i] : 0.0;
+      if (!(zd[i] > 0.0)) zd[i] = 0.0;
+    };
+    if (count < best_count || tries > 0) {
+      if (count < best_count) {
+        best_count = count;
+        tries = kBlockTries;
+      } else {
+        --tries;
+      }
+      for (Index i = 0; i < n; ++i) {
+        const bool in = active_[static_cast<std::size_t>(i)] != 0;
+        if (x_[i] < -(in ? tol_z : tol_w)) flip(i);
+      }
+      result.pivots += count;
+    } else {  // Murty: switch only the largest infeasible index
+      flip(last);
+      result.pivots += 1;
+    }
+  }
+  for (Index i = 0; i < n; ++i) {
+    const double v = std::max(x_[i], 0.0);
+    const bool in = active_[static_cast<std::size_t>(i)] != 0;
+    z[i] = in ? v : 0.0;
+    w[i] = in ? 0.0 : v;
+  }
+  return result;
+}
+
+void BandedLcpSolver::rebuild_set() {
+  set_.clear();
+  for (std::size_t i = 0; i < active_.size(); ++i) {
+    if (active_[i]) set_.push_back(static_cast<int>(i));
+  }
+}
+
+void BandedLcpSolver::reset_active_set(const Eigen::Ref<const Vector>& z) {
+  if (!has_matrix_) throw InputError("banded LCP: reset_active_set called before set_matrix");
+  if (z.size() != M_.rows()) {
+    throw InputError(fmt::format("banded LCP: reset_active_set: z has size {}, expected {}",
+                                 z.size(), M_.rows()));
+  }
+  for (Index i = 0; i < z.size(); ++i) active_[static_cast<std::size_t>(i)] = z[i] > 0.0 ? 1 : 0;
+  rebuild_set();
+}
+
+LcpResult BandedLcpSolver::solve_forces(const Eigen::Ref<const Vector>& q, Eigen::Ref<Vector> z) {
+  if (!has_matrix_) throw InputError("banded LCP: solve_forces called before set_matrix");
+  const Index n = M_.rows();
+  if (q.size() != n || z.size() != n) {
+    throw InputError(fmt::format("banded LCP: solve_forces: q and z have sizes {} and {}; "
+                                 "expected {}",
+                                 q.size(), z.size(), n));
+  }
+  LcpResult result;
+  double qmax = 0.0;
+  negative_.clear();
+  for (Index i = 0; i < n; ++i) {
+    qmax = std::max(qmax, std::abs(q[i]));
+    if (q[i] < 0.0) negative_.push_back(static_cast<int>(i));
+  }
+  const double tol_w = kFeasTol * qmax;
+  const double tol_z = tol_w / scale_;
+  double* zd = z.data();
+  // As solve(): when no q_i is below -tol, z = 0 (and that is not counted as pivots).
+  bool all_feasible = true;
+  for (int i : negative_) all_feasible = all_feasible && q[i] >= -tol_w;
+  if (all_feasible) {
+    for (int j : set_) {
+      zd[j] = 0.0;
+      active_[static_cast<std::size_t>(j)] = 0;
+    }
+    set_.clear();
+    return result;
+  }
+  const Index cw = columns_.width();
+  int best_count = static_cast<int>(n) + 1;
+  int tries = kBlockTries;
+  for (long iter = 0;; ++iter) {
+    if (iter >= max_iterations_) {
+      throw LcpError(fmt::format(
+          "banded block pivoting: no solution after {} iterations (n = {}), the iteration limit "
+          "(M is not a P-matrix?)",
+          iter, n));
+    }
+    if (set_.empty()) {
+      // z = 0: feasible unless some q_i < -tol.
+      flips_.clear();
+      for (int i : negative_) {
+        if (q[i] < -tol_w) flips_.push_back(i);
+      }
+    } else {
+      solve_active(q, zd);
+      // M z on the band of the active set.
+      touched_.clear();
+      for (int j : set_) {
+        const double zj = zd[j];
+        const double* a = columns_.row_values(j);
+        const Index f = columns_.first_column(j);
+        for (Index k = 0; k < cw; ++k) {
+          if (a[k] == 0.0) continue;
+          const auto i = static_cast<std::size_t>(f + k);
+          if (!seen_[i]) {
+            seen_[i] = 1;
+            touched_.push_back(static_cast<int>(i));
+          }
+          scratch_[i] += a[k] * zj;
+        }
+      }
+      flips_.clear();
+      for (int j : set_) {
+        if (zd[j] < -tol_z) flips_.push_back(j);
+      }
+      const auto check_slack = [&](int i) {
+        if (active_[static_cast<std::size_t>(i)] || seen_[static_cast<std::size_t>(i)] == 2) return;
+        if (q[i] + scratch_[static_cast<std::size_t>(i)] < -tol_w) flips_.push_back(i);
+        seen_[static_cast<std::size_t>(i)] = 2;
+      };
+      for (int i : touched_) check_slack(i);
+      for (int i : negative_) check_slack(i);
+      for (int i : touched_) {
+        scratch_[static_cast<std::size_t>(i)] = 0.0;
+        seen_[static_cast<std::size_t>(i)] = 0;
+      }
+      for (int i : negative_) seen_[static_cast<std::size_t>(i)] = 0;
+    }
+    const int count = static_cast<int>(flips_.size());
+    if (count == 0) break;
+    if (count < best_count || tries > 0) {
+      if (count < best_count) {
+        best_count = count;
+        tries = kBlockTries;
+      } else {
+        --tries;
+      }
+      result.pivots += count;
+    } else {  // Murty: switch only the largest infeasible index
+      const int last = *std::max_element(flips_.begin(), flips_.end());
+      flips_.assign(1, last);
+      result.pivots += 1;
+    }
+    for (int i : flips_) {
+      unsigned char& a = active_[static_cast<std::size_t>(i)];
+      a ^= 1;
+      zd[i] = a ? std::max(0.0, -q[i] / diagonal_[i]) : 0.0;
+    }
+    // The new active set, ascending: the old one without the leavers, merged with the entrants.
+    std::sort(flips_.begin(), flips_.end());
+    std::vector<int>& merged = touched_;  // reused as scratch
+    merged.clear();
+    std::size_t a = 0, b = 0;
+    while (a < set_.size() || b < flips_.size()) {
+      if (b == flips_.size() || (a < set_.size() && set_[a] < flips_[b])) {
+        merged.push_back(set_[a++]);
+      } else if (a == set_.size() || flips_[b] < set_[a]) {
+        merged.push_back(flips_[b++]);  // entered
+      } else {
+        ++a;  // left
+        ++b;
+      }
+    }
+    set_.swap(merged);
+  }
+  for (int j : set_) zd[j] = std::max(zd[j], 0.0);
+  return result;
+}
+
+void BandedLcpSolver::solve_active(const Eigen::Ref<const Vector>& q, double* z) {
+  if (set_.empty()) return;
+  if (iterate_ && gauss_seidel(q, z)) return;
+  factorize_and_solve(q, z);
+}
+
+bool BandedLcpSolver::gauss_seidel(const Eigen::Ref<const Vector>& q, double* z) {
+  for (int sweep = 0; sweep < options_.max_sweeps; ++sweep) {
+    ++sweeps_;
+    double moved = 0.0, largest = 0.0;
+    for (const int i : set_) {
+      const double update = (-q[i] - row_dot(M_, i, z)) / diagonal_[i];
+      z[i] += update;
+      moved = std::max(moved, std::abs(update));
+      largest = std::max(largest, std::abs(z[i]));
+    }
+    if (moved <= kSweepTol * largest) return true;
+  }
+  return false;
+}
+
+void BandedLcpSolver::factorize_and_solve(const Eigen::Ref<const Vector>& q, double* z) {
+  const Index N = static_cast<Index>(set_.size());
+  const Index lo = lower_, up = upper_, W = lower_ + upper_ + 1;
+  const auto at = [&](Index a, Index b) -> double& {
+    return lu_[static_cast<std::size_t>(a * W + (b - a + lo))];
+  };
+  // Elimination without pivoting never changes earlier rows, so the factors of the rows before
+  // the first position where the active set differs from the factored one stay valid, except the
+  // entries of the last `upper` of those rows that lie in the changed columns: factorisation
+  // restarts `upper` rows before the first difference.
+  Index p0 = 0;
+  const Index common = std::min<Index>(N, static_cast<Index>(factored_.size()));
+  while (p0 < common && set_[static_cast<std::size_t>(p0)] == factored_[static_cast<std::size_t>(p0)]) {
+    ++p0;
+  }
+  if (p0 < N || static_cast<Index>(factored_.size()) != N) {
+    p0 = std::max<Index>(0, p0 - up);
+    for (Index a = p0; a < N; ++a) {
+      const Index i = set_[static_cast<std::size_t>(a)];
+      for (Index b = std::max<Index>(0, a - lo); b <= std::min(N - 1, a + up); ++b) {
+        at(a, b) = M_.coeff(i, set_[static_cast<std::size_t>(b)]);
+      }
+    }
+    const double tiny = kSingularTol * static_cast<double>(W) * scale_;
+    for (Index k = std::max<Index>(0, p0 - lo); k < N; ++k) {
+      const double pivot = at(k, k);
+      if (k >= p0 && !(pivot > tiny)) {
+        factored_.clear();
+        throw LcpError(fmt::format(
+            "banded block pivoting: pivot {} of the principal block for {} active springs is {} "
+            "(M is not a P-matrix?)",
+            k, N, pivot));
+      }
+      for (Index a = std::max(k + 1, p0); a <= std::min(N - 1, k + lo); ++a) {
+        double& l = at(a, k);
+        if (l == 0.0) continue;
+        l /= pivot;
+        for (Index b = k + 1; b <= std::min(N - 1, k + up); ++b) at(a, b) -= l * at(k, b);
+      }
+    }
+    factorized_rows_ += N - p0;
+    factored_ = set_;
+  }
+  for (Index a = 0; a < N; ++a) {
+    double s = -q[set_[static_cast<std::size_t>(a)]];
+    for (Index k = std::max<Index>(0, a - lo); k < a; ++k) s -= at(a, k) * rhs_[static_cast<std::size_t>(k)];
+    rhs_[static_cast<std::size_t>(a)] = s;
+  }
+  for (Index a = N - 1; a >= 0; --a) {
+    double s = rhs_[static_cast<std::size_t>(a)];
+    for (Index b = a + 1; b <= std::min(N - 1, a + up); ++b) s -= at(a, b) * rhs_[static_cast<std::size_t>(b)];
+    rhs_[static_cast<std::size_t>(a)] = s / at(a, a);
+  }
+  for (Index a = 0; a < N; ++a) z[set_[static_cast<std::size_t>(a)]] = rhs_[static_cast<std::size_t>(a)];
+}
+
+bool is_p_matrix(const BandedMatrix& M, std::string* why) {
+  std::string scratch;
+  if (why == nullptr) why = &scratch;
+  if (M.rows() != M.cols()) {
+    *why = fmt::format("M is {}x{}: not square", M.rows(), M.cols());
+    return false;
+  }
+  const Index n = M.rows();
+  bool dominant = true;
+  for (Index i = 0; i < n && dominant; ++i) {
+    const double* a = M.row_values(i);
+    double off = 0.0;
+    for (Index k = 0; k < M.width(); ++k) {
+      if (M.first_column(i) + k != i) off += std::abs(a[k]);
+    }
+    const double d = M.coeff(i, i);
+    dominant = d > 0.0 && off < d;
+  }
+  if (dominant) return true;
+  // Banded Cholesky of the symmetric part.
+  const Index b = std::max(M.lower_bandwidth(), M.upper_bandwidth());
+  const Index W = b + 1;
+  std::vector<double> L(static_cast<std::size_t>(n * W), 0.0);  // L(i, j), j in [i-b, i]
+  const auto at = [&](Index i, Index j) -> double& {
+    return L[static_cast<std::size_t>(i * W + (j - i + b))];
+  };
+  for (Index i = 0; i < n; ++i) {
+    for (Index j = std::max<Index>(0, i - b); j <= i; ++j) {
+      double s = 0.5 * (M.coeff(i, j) + M.coeff(j, i));
+      for (Index k = std::max<Index>(0, i - b); k < j; ++k) s -= at(i, k) * at(j, k);
+      if (j < i) {
+        at(i, j) = s / at(j, j);
+      } else if (s > 0.0) {
+        at(i, i) = std::sqrt(s);
+      } else {
+        *why = fmt::format(
+            "M is neither strictly diagonally dominant with a positive diagonal nor has a "
+            "positive definite symmetric part (pivot {} of its Cholesky factorisation is {})",
+            i, s);
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+}  // namespace pwl

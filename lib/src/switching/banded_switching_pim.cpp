@@ -1,0 +1,698 @@
+// The higher-order PIM of switching_pim.hpp with the banded operators of He, Gao & Zhong, Appl.
+// Math. Mech. 39(7) (2018) 737-749, §2: the force moments of every substructure assembled into
+// banded matrices, sparse products in the Taylor recursion and in the pieces of switching steps.
+#include "pwl/integrators/banded_switching_pim.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <unordered_map>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "event/event_location.hpp"
+#include "pwl/numerics/banded_matrix.hpp"
+#include "pwl/integrators/banded_pim_integrator.hpp"
+#include "pwl/integrators/banded_step_operators.hpp"
+#include "pwl/errors.hpp"
+#include "integrators/fixed_step_count.hpp"
+#include "pwl/numerics/substructure_exponential.hpp"
+#include "switching/switching_pim_detail.hpp"
+
+namespace pwl {
+
+bool BandedSwitchingPimOptions::is_valid(std::string* why) const {
+  std::string scratch;
+  if (why == nullptr) why = &scratch;
+  if (!pim.is_valid(why)) {
+    *why = "pim." + *why;
+    return false;
+  }
+  if (!band.is_valid(why)) {
+    *why = "band." + *why;
+    return false;
+  }
+  if (!lcp.is_valid(why)) {
+    *why = "lcp." + *why;
+    return false;
+  }
+  return true;
+}
+
+namespace {
+
+using event_detail::GapSample;
+using switching_detail::PolynomialGaps;
+using RowSparse = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
+
+// The coefficients of the step's force polynomial (switching_pim.cpp, make_operators and the
+// stepper's constructor) from the moments Ξ̂_0 .. Ξ̂_{d+1} (Ξ̂_{d+2} with the end slope):
+// correction[r] multiplies p_r (with the end slope, the predicted slope Σ r p_r folded in, and one
+// more for p_{d+1}), phi multiplies P_{k+1}, slope the correction of η P'_{k+1}.
+struct ForceCoefficients {
+  std::vector<Matrix> correction;
+  Matrix phi, slope;
+};
+
+ForceCoefficients force_coefficients(const std::vector<Matrix>& moments, int d, bool end) {
+  const auto moment = [&](int r) -> const Matrix& { return moments[static_cast<std::size_t>(r)]; };
+  ForceCoefficients c;
+  if (!end) {
+    c.phi = moment(d + 1);
+    for (int r = 0; r <= d; ++r) c.correction.push_back(moment(r) - c.phi);
+    c.slope = Matrix::Zero(c.phi.rows(), c.phi.cols());
+    return c;
+  }
+  const Matrix delta = moment(d + 2) - moment(d + 1);
+  c.phi = moment(d + 1) - (d + 1) * delta;
+  for (int r = 0; r <= d; ++r) c.correction.push_back(moment(r) - moment(d + 1) + (d + 1 - r) * delta);
+  c.slope = delta;
+  for (int r = 1; r <= d; ++r) c.correction[static_cast<std::size_t>(r)] += r * c.slope;
+  c.correction.push_back((d + 1) * c.slope);
+  return c;
+}
+
+// Row blocks with their substructures, partitioned as banded_exponential.cpp does (margin R on
+// each side, clamped at the ends; single cells in the interior of a periodic structure, so that
+// their substructures coincide).
+struct RowBlock {
+  Index begin, end;
+  Index window_first, window_last;
+};
+
+std::vector<RowBlock> partition_rows(Index n, Index margin, Index cell) {
+  std::vector<RowBlock> blocks;
+  const Index step = cell > 0 ? cell : std::max<Index>(1, margin);
+  const Index left = cell > 0 ? std::max<Index>(cell, (margin + cell - 1) / cell * cell) : step;
+  const auto add = [&](Index b, Index e) {
+    blocks.push_back({b, e, std::max<Index>(0, b - margin), std::min(n, e + margin)});
+  };
+  if (left + margin >= n) {
+    add(0, n);
+    return blocks;
+  }
+  add(0, left);
+  Index r = left;
+  while (r + step + margin <= n) {
+    add(r, r + step);
+    r += step;
+  }
+  if (r < n) add(r, n);
+  return blocks;
+}
+
+// The force coefficients for unit accelerations at every degree of freedom (G = [0; I]) as banded
+// 2n x n matrices on the interleaved state, band q: each row read off the substructure of its
+// block, whose moments come from polynomial_force_integrals on the substructure's H.
+// Returns correction..., phi, slope in that order.
+std::vector<BandedMatrix> banded_force_coefficients(const GapStructure& s, double eta, int d,
+                                                    bool end, Index q, Index margin, Index cell,
+                                                    const BandedExponentialOptions& o) {
+  const Index n = s.dofs();
+  const std::vector<RowBlock> blocks = partition_rows(n, margin, cell);
+  const std::size_t count = static_cast<std::size_t>(d + 1 + (end ? 1 : 0) + 2);
+  std::vector<BandedMatrixBuilder> builders;
+  builders.reserve(count);
+  for (std::size_t k = 0; k < count; ++k) builders.emplace_back(2 * n, n, 2 * q + 1, o.share_rows);
+  std::unordered_map<SubstructureKey, std::shared_ptr<const std::vector<Matrix>>,
+                     SubstructureKey::Hasher>
+      cache;
+  std::vector<double> row(static_cast<std::size_t>(2 * q + 1));
+  for (const RowBlock& block : blocks) {
+    SubstructureKey key(s, block.window_first, block.window_last);
+    auto it = cache.find(key);
+    if (it == cache.end()) {
+      // Keep the cache small for structures whose cells all differ.
+      if (cache.size() >= 64) cache.clear();
+      const Index w = block.window_last - block.window_first;
+      const Matrix H = substructure_state_matrix(s, block.window_first, block.window_last);
+      Matrix G = Matrix::Zero(2 * w, w);
+      G.bottomRows(w).setIdentity();
+      const PolynomialForceIntegrals pfi =
+          polynomial_force_integrals(H, eta, G, d + (end ? 2 : 1), o.exponential);
+      ForceCoefficients c = force_coefficients(pfi.moments, d, end);
+      auto all = std::make_shared<std::vector<Matrix>>(std::move(c.correction));
+      all->push_back(std::move(c.phi));
+      all->push_back(std::move(c.slope));
+      it = cache.emplace(std::move(key), std::move(all)).first;
+    }
+    const std::vector<Matrix>& coefficients = *it->second;
+    const Index w = block.window_last - block.window_first, first = block.window_first;
+    for (Index i = block.begin; i < block.end; ++i) {
+      const Index li = i - first;
+      const Index lo = std::max<Index>(0, i - q), hi = std::min(n, i + q + 1);
+      const Index span = hi - lo, l0 = lo - first;
+      for (int a = 0; a < 2; ++a) {
+        const Index r = a * w + li;
+        for (std::size_t k = 0; k < count; ++k) {
+          for (Index j = 0; j < span; ++j) row[static_cast<std::size_t>(j)] = coefficients[k](r, l0 + j);
+          builders[k].set_row(2 * i + a, lo, row.data(), span);
+        }
+      }
+    }
+  }
+  std::vector<BandedMatrix> out;
+  out.reserve(count);
+  for (BandedMatrixBuilder& b : builders) out.push_back(b.build());
+  return out;
+}
+
+// max_i Σ_j |A_ij|.
+double infinity_norm(const RowSparse& A) {
+  double largest = 0.0;
+  for (Index i = 0; i < A.outerSize(); ++i) {
+    double sum = 0.0;
+    for (RowSparse::InnerIterator it(A, i); it; ++it) sum += std::abs(it.value());
+    largest = std::max(largest, sum);
+  }
+  return largest;
+}
+
+struct LoadTerm {
+  double omega;
+  Vector sin_part;  // M⁻¹ times the load's sin part
+  Vector cos_part;
+};
+
+class BandedStepper final : public SwitchingPim {
+ public:
+  BandedStepper(const GapStructure& s, const BandedSwitchingPimOptions& options)
+      : o_(options.pim), n_(s.dofs()), m_(s.spring_count()), d_(options.pim.force_degree),
+        eta_(options.pim.step), end_derivative_(options.pim.end_derivative),
+        solver_(options.lcp) {
+    // Sparse parts of the equation of motion, springs by position along the structure.
+    const Vector inverse_mass = s.mass.diagonal().cwiseInverse();
+    const std::vector<Index> order = springs_by_position(s);
+    gaps_.resize(m_);
+    stiffnesses_.resize(m_);
+    std::vector<Eigen::Triplet<double>> w;
+    for (Index j = 0; j < m_; ++j) {
+      const GapSpring& g = s.springs[static_cast<std::size_t>(order[static_cast<std::size_t>(j)])];
+      gaps_[j] = g.gap;
+      stiffnesses_[j] = g.stiffness;
+      w.emplace_back(g.dof, j, g.direction);
+      if (g.other_dof >= 0) w.emplace_back(g.other_dof, j, -g.direction);
+    }
+    SparseMatrix W(n_, m_);
+    W.setFromTriplets(w.begin(), w.end());
+    SparseMatrix minus_inverse_mass(n_, n_);
+    {
+      std::vector<Eigen::Triplet<double>> diag;
+      for (Index i = 0; i < n_; ++i) diag.emplace_back(i, i, -inverse_mass[i]);
+      minus_inverse_mass.setFromTriplets(diag.begin(), diag.end());
+    }
+    stiffness_part_ = RowSparse(minus_inverse_mass * s.stiffness);
+    damping_part_ = RowSparse(minus_inverse_mass * s.damping);
+    const SparseMatrix force_part = minus_inverse_mass * W;
+    force_part_ = RowSparse(force_part);
+    gap_rows_ = RowSparse(SparseMatrix(W.transpose()));
+    spring_rows_ = RowSparse(stiffnesses_.asDiagonal() * gap_rows_);
+    spring_offset_ = stiffnesses_.cwiseProduct(gaps_);
+    abs_row_sums_.resize(m_);
+    for (Index j = 0; j < m_; ++j) {
+      double sum = 0.0;
+      for (RowSparse::InnerIterator it(gap_rows_, j); it; ++it) sum += std::abs(it.value());
+      abs_row_sums_[j] = sum;
+    }
+    for (const LoadGroup& g : s.load_groups()) {
+      loads_.push_back({g.omega, g.sin_part.cwiseProduct(inverse_mass),
+                        g.cos_part.cwiseProduct(inverse_mass)});
+    }
+
+    // η ω_max as the dense stepper bounds it (every spring touching).
+    const RowSparse k_all =
+        RowSparse(-stiffness_part_) - RowSparse(force_part_ * stiffnesses_.asDiagonal() * gap_rows_);
+    const double kn = infinity_norm(k_all);
+    const double cn = infinity_norm(damping_part_);
+    diagnostics_.step_argument = eta_ * 0.5 * (cn + std::sqrt(cn * cn + 4.0 * kn));
+    if ((d_ > 0 || end_derivative_) && diagnostics_.step_argument > o_.max_step_argument) {
+      throw InputError(fmt::format(
+          "pim.step = {}: η ω_max = {:.3g} exceeds max_step_argument = {} (the contact is too "
+          "stiff for the force derivatives at this step); use a step below {:.3g}, or "
+          "force_degree = 0 with end_derivative = false",
+          eta_, diagnostics_.step_argument, o_.max_step_argument,
+          eta_ * o_.max_step_argument / diagnostics_.step_argument));
+    }
+
+    // T, the harmonic responses and the band from the banded exponential; the force
+    // coefficients from the same substructures.
+    BandedExponentialOptions band = options.band;
+    if (band.cell_dofs == 0) band.cell_dofs = detect_cell_size(s);
+    BandedExponential e = make_banded_exponential(s, eta_, band);
+    truncation_ = e.truncation;
+    transition_ = std::move(e.transition);
+    harmonics_ = std::move(e.harmonics);
+    if (m_ > 0) {
+      const std::vector<BandedMatrix> unit = banded_force_coefficients(
+          s, eta_, d_, end_derivative_, truncation_.band, truncation_.margin,
+          truncation_.cell_dofs, band);
+      const std::size_t corrections = unit.size() - 2;
+      for (std::size_t r = 0; r < corrections; ++r) {
+        correction_.push_back(multiply(unit[r], force_part));
+        correction_columns_.push_back(transpose(correction_.back()));
+      }
+      phi_ = multiply(unit[corrections], force_part);
+      phi_columns_ = transpose(phi_);
+      slope_ = multiply(unit[corrections + 1], force_part);
+      slope_columns_ = transpose(slope_);
+      // I - K2 W^T Φ_x.
+      const SparseMatrix minus_spring_rows = -SparseMatrix(spring_rows_);
+      const BandedMatrix lcp =
+          add_diagonal(multiply(minus_spring_rows, select_rows(phi_, 0, 2)), Vector::Ones(m_));
+      std::string why;
+      if (!is_p_matrix(lcp, &why)) {
+        throw InputError(fmt::format("pim.step = {}: the step's LCP matrix is not a P-matrix "
+                                     "({}); use a smaller step",
+                                     eta_, why));
+      }
+      solver_.set_matrix(lcp);
+    }
+
+    const int terms = std::max(o_.max_series_terms, d_ + 2) + 1;
+    xs_.assign(static_cast<std::size_t>(terms), Vector::Zero(n_));
+    us_.assign(static_cast<std::size_t>(terms), Vector::Zero(n_));
+    ps_.assign(static_cast<std::size_t>(terms), Vector::Zero(m_));
+    gw_.assign(static_cast<std::size_t>(terms), Vector::Zero(m_));
+    mode_ = Vector::Zero(m_);
+    signs_ = Vector::Constant(m_, -1.0);
+    state_ = Vector::Zero(2 * n_);
+    bar_ = state_;
+    acc_ = Vector::Zero(n_);
+    half_ = acc_;
+    vx_ = acc_;
+    vu_ = acc_;
+    z_ = Vector::Zero(m_);
+    q_ = z_;
+    slope_guess_ = z_;
+    position_ = Vector::Zero(n_);
+    velocity_ = position_;
+  }
+
+  std::string name() const override {
+    return fmt::format("pim-switching-banded (order {}{}, step {:.6g}, band {})",
+                       d_ + (end_derivative_ ? 3 : 2),
+                       o_.locate_switches ? ", located switches" : "", eta_, truncation_.band);
+  }
+  Index dofs() const override { return n_; }
+  double time() const override { return origin_ + static_cast<double>(steps_) * eta_; }
+  const Vector& position() const override { return position_; }
+  const Vector& velocity() const override { return velocity_; }
+  IntegratorStats stats() const override { return stats_; }
+  SwitchingPimDiagnostics diagnostics() const override { return diagnostics_; }
+
+  void set_state(double t, const Vector& x, const Vector& v) override {
+    if (x.size() != n_ || v.size() != n_) {
+      throw InputError(fmt::format("state has {} displacements and {} velocities, expected {}",
+                                   x.size(), v.size(), n_));
+    }
+    if (!std::isfinite(t) || !x.allFinite() || !v.allFinite()) {
+      throw InputError(fmt::format("initial state at t = {} has a non-finite entry", t));
+    }
+    origin_ = t;
+    steps_ = 0;
+    state_ = interleave_state(x, v);
+    // Touching where the gap is closed; a spring exactly at its kink starts slack and the first
+    // step settles it from its derivatives.
+    const Vector g = gap_rows_ * x - gaps_;
+    for (Index j = 0; j < m_; ++j) set_mode(j, g[j] > 0.0);
+    x_scale_ = x.cwiseAbs().maxCoeff();
+    lcp_synced_ = false;
+    sync();
+  }
+
+  void advance_to(double t_end, const StepObserver& observer) override {
+    const long count = detail::fixed_step_count(t_end, time(), eta_);
+    for (long k = 0; k < count; ++k) {
+      step();
+      if (observer) {
+        sync();
+        observer(time(), position_, velocity_);
+      }
+    }
+    sync();
+  }
+
+ private:
+  void set_mode(Index j, bool on) {
+    mode_[j] = on ? 1.0 : 0.0;
+    signs_[j] = on ? 1.0 : -1.0;
+  }
+
+  void sync() { deinterleave_state(state_, position_, velocity_); }
+
+  // The springs whose force can be non-zero in the current mode.
+  void collect_acting() {
+    acting_.clear();
+    for (Index j = 0; j < m_; ++j) {
+      if (mode_[j] > 0.0) acting_.push_back(static_cast<int>(j));
+    }
+  }
+
+  // y += A p for p zero outside acting_: by the rows of A when many springs act, by the columns
+  // of the acting ones otherwise (O(contacts · q)).
+  void add_forces(const BandedMatrix& A, const BandedMatrix& columns, const Vector& p,
+                  Vector& y) const {
+    if (acting_.empty()) return;
+    if (4 * static_cast<Index>(acting_.size()) > m_) {
+      A.multiply_add(p.data(), y.data());
+    } else {
+      columns.transpose_multiply_add(p.data(), acting_.data(), static_cast<Index>(acting_.size()),
+                                     y.data());
+    }
+  }
+
+  // Scaled Taylor coefficients of the motion in the current mode about time t for a step h, as
+  // in switching_pim.cpp but with sparse products: xs_[r] = x^{(r)} h^r / r!, us_[r] the same for
+  // x', ps_[r] = P^{(r)} h^r / r!, gw_[r] = W^T xs_[r]. xs_[0] and us_[0] hold the start. Computes
+  // xs_ and gw_ up to `last`, us_ and ps_ up to last - 1 (us_[last] too when full). When
+  // tol > 0, stops once two consecutive terms are below tol times the largest; returns the index
+  // of the last term computed. With first > 0 the terms up to `first` are those of a call with
+  // the same t, h and start that stopped there, and the series continues from them.
+  int taylor(double t, double h, int last, double tol, bool full = true, int first = 0) {
+    double largest = 0.0;
+    if (first == 0) {
+      gw_[0].noalias() = gap_rows_ * xs_[0];
+      for (std::size_t g = 0; g < loads_.size(); ++g) {
+        phase_sin_[g] = std::sin(loads_[g].omega * t);
+        phase_cos_[g] = std::cos(loads_[g].omega * t);
+        load_scale_[g] = 1.0;
+      }
+    }
+    for (int r = 0; r < first; ++r) {
+      largest = std::max({largest, xs_[static_cast<std::size_t>(r)].cwiseAbs().maxCoeff(),
+                          us_[static_cast<std::size_t>(r)].cwiseAbs().maxCoeff()});
+    }
+    largest = std::max({largest, xs_[static_cast<std::size_t>(first)].cwiseAbs().maxCoeff(),
+                        first == 0 ? us_[0].cwiseAbs().maxCoeff() : 0.0});
+    double previous = largest;
+    for (int r = first; r < last; ++r) {
+      const auto ru = static_cast<std::size_t>(r);
+      ps_[ru] = mode_.cwiseProduct(stiffnesses_.cwiseProduct(gw_[ru]));
+      if (r == 0) ps_[ru] -= mode_.cwiseProduct(spring_offset_);
+      const double f = h / (r + 1);
+      xs_[ru + 1] = f * us_[ru];
+      gw_[ru + 1].noalias() = gap_rows_ * xs_[ru + 1];
+      if (!full && r + 1 == last) break;  // the last velocity term is not needed
+      acc_.noalias() = stiffness_part_ * xs_[ru];
+      acc_.noalias() += damping_part_ * us_[ru];
+      if (!acting_.empty()) acc_.noalias() += force_part_ * ps_[ru];
+      for (std::size_t g = 0; g < loads_.size(); ++g) {
+        // d^r/dt^r of sin and cos at ωt, scaled by (ωh)^r / r!: the cycle (S, C, -S, -C).
+        const double S = phase_sin_[g], C = phase_cos_[g];
+        double ds = 0.0, dc = 0.0;
+        switch (r % 4) {
+          case 0: ds = S; dc = C; break;
+          case 1: ds = C; dc = -S; break;
+          case 2: ds = -S; dc = -C; break;
+          default: ds = -C; dc = S; break;
+        }
+        const double scale = load_scale_[g];
+        if (scale != 0.0) acc_ += scale * (ds * loads_[g].sin_part + dc * loads_[g].cos_part);
+        load_scale_[g] = scale * loads_[g].omega * h / (r + 1);
+      }
+      us_[ru + 1] = f * acc_;
+      if (tol > 0.0) {
+        const double size =
+            std::max(xs_[ru + 1].cwiseAbs().maxCoeff(), us_[ru + 1].cwiseAbs().maxCoeff());
+        largest = std::max(largest, size);
+        if (r + 1 >= 4 && size + previous <= tol * largest) return r + 1;
+        previous = size;
+      }
+    }
+    return last;
+  }
+
+  // Σ_r a_r σ^r for the state, into vx_ and vu_.
+  void evaluate_series(int R, double sigma) {
+    vx_ = xs_[static_cast<std::size_t>(R)];
+    vu_ = us_[static_cast<std::size_t>(R)];
+    for (int r = R - 1; r >= 0; --r) {
+      vx_ = vx_ * sigma + xs_[static_cast<std::size_t>(r)];
+      vu_ = vu_ * sigma + us_[static_cast<std::size_t>(r)];
+    }
+  }
+
+  double kink_tolerance(Index j, const Vector& x) const {
+    double reach = 0.0;
+    for (RowSparse::InnerIterator it(gap_rows_, j); it; ++it) {
+      reach += std::abs(it.value()) * std::abs(x[it.col()]);
+    }
+    return 64.0 * kEpsilon * (std::abs(gaps_[j]) + reach + abs_row_sums_[j] * x_scale_);
+  }
+
+  // The gap polynomial of gw_[0..R] (mode-signed) on σ in [0, 1]; settles the springs on their
+  // kink at σ = 0 (switching_pim.cpp). Returns true when a spring must switch at σ = 0.
+  bool prepare_polynomial(int R) {
+    poly_.c.resize(m_, R + 1);
+    for (int r = 0; r <= R; ++r) {
+      const auto ru = static_cast<std::size_t>(r);
+      if (r == 0) {
+        poly_.c.col(0) = signs_.cwiseProduct(gw_[0] - gaps_);
+      } else {
+        poly_.c.col(r) = signs_.cwiseProduct(gw_[ru]);
+      }
+    }
+    start_ = GapSample();
+    poly_.sample(start_, 0.0, start_);
+    settings_.nominal_spacing = 1.0;
+    settings_.max_spacing = 0.0;
+    settings_.min_width = 64.0 * kEpsilon;
+    settings_.tolerance = Vector::Zero(m_);
+    settings_.certified_until = Vector::Constant(m_, -std::numeric_limits<double>::infinity());
+    flip_.clear();
+    for (Index j = 0; j < m_; ++j) {
+      const double tol = kink_tolerance(j, xs_[0]);
+      if (start_.e[j] > tol) continue;
+      double until = 0.0;
+      const int verdict =
+          locator_.certify_departure(poly_, start_, j, tol, 1.0, settings_.min_width, &until);
+      if (verdict < 0) {
+        flip_.push_back(j);
+      } else {
+        settings_.certified_until[j] = until;
+        if (verdict == 0) settings_.tolerance[j] = tol;
+      }
+    }
+    return !flip_.empty();
+  }
+
+  void step() {
+    const double t = time();
+    deinterleave_state(state_, xs_[0], us_[0]);
+    collect_acting();
+    taylor(t, eta_, d_ + 1, 0.0, false);
+    if (o_.locate_switches && screen_fails()) {
+      ++diagnostics_.screened;
+      switching_step(t);
+      return;
+    }
+    transition_.multiply(state_.data(), bar_.data());
+    for (std::size_t g = 0; g < harmonics_.size(); ++g) {
+      bar_ += phase_sin_[g] * harmonics_[g].sin_response + phase_cos_[g] * harmonics_[g].cos_response;
+    }
+    if (end_derivative_) {
+      const auto last = static_cast<std::size_t>(d_ + 1);
+      ps_[last] = mode_.cwiseProduct(stiffnesses_.cwiseProduct(gw_[last]));
+      slope_guess_ = static_cast<double>(d_ + 1) * ps_[last];
+      for (int r = 1; r <= d_; ++r) slope_guess_ += static_cast<double>(r) * ps_[static_cast<std::size_t>(r)];
+    }
+    for (std::size_t r = 0; r < correction_.size(); ++r) {
+      add_forces(correction_[r], correction_columns_[r], ps_[r], bar_);
+    }
+    const double largest = bar_.cwiseAbs().maxCoeff();
+    if (!(largest <= o_.divergence_bound)) {
+      throw DivergenceError(fmt::format(
+          "the motion blew up at t = {}: largest |x| or |x'| is {} (divergence_bound {})",
+          t + eta_, largest, o_.divergence_bound));
+    }
+    if (m_ > 0) {
+      for (Index i = 0; i < n_; ++i) half_[i] = bar_[2 * i];
+      q_ = spring_offset_;
+      q_.noalias() -= spring_rows_ * half_;
+      if (!lcp_synced_) {
+        // Warm start from the mode (z must be zero outside the active set).
+        z_ = mode_;
+        solver_.reset_active_set(z_);
+        lcp_synced_ = true;
+      }
+      stats_.lcp_pivots += solver_.solve_forces(q_, z_).pivots;
+    }
+    if (o_.locate_switches) {
+      for (Index j = 0; j < m_; ++j) {
+        if ((z_[j] > 0.0) != (mode_[j] > 0.0)) {
+          ++diagnostics_.lcp_mismatches;
+          switching_step(t);
+          return;
+        }
+      }
+    } else {
+      for (Index j = 0; j < m_; ++j) set_mode(j, z_[j] > 0.0);
+      collect_acting();
+    }
+    state_.swap(bar_);
+    add_forces(phi_, phi_columns_, z_, state_);
+    if (end_derivative_ && o_.locate_switches && !acting_.empty()) {
+      // Correct with the slope the new state gives (the mode is the same at both ends).
+      for (Index i = 0; i < n_; ++i) half_[i] = state_[2 * i + 1];
+      slope_guess_ = eta_ * mode_.cwiseProduct(stiffnesses_.cwiseProduct(gap_rows_ * half_)) -
+                     slope_guess_;
+      add_forces(slope_, slope_columns_, slope_guess_, state_);
+    }
+    finish_step();
+  }
+
+  // True when some gap polynomial might reach zero on the step (switching_pim.cpp).
+  bool screen_fails() const {
+    for (Index j = 0; j < m_; ++j) {
+      const double e0 = signs_[j] * (gw_[0][j] - gaps_[j]);
+      const double e1 = signs_[j] * gw_[1][j];
+      double rest = 0.0;
+      for (int r = 2; r <= d_ + 1; ++r) rest += std::abs(gw_[static_cast<std::size_t>(r)][j]);
+      if (!(e0 > 0.0 && e0 + e1 - rest > 0.0)) return true;
+    }
+    return false;
+  }
+
+  // The step redone in pieces, each following the Taylor series of the current mode (sparse
+  // products, the whole state) up to the first located switch or the end of the step. On entry
+  // xs_[0], us_[0] hold the step's start and the series up to order d_ + 1 is in the buffers.
+  void switching_step(double t0) {
+    ++diagnostics_.switching_steps;
+    lcp_synced_ = false;
+    double s = 0.0;
+    int guard = 0;
+    int resume = d_;
+    while (s < eta_) {
+      if (++guard > 10000) {
+        throw DivergenceError(fmt::format(
+            "pim-switching-banded: more than 10000 pieces in the step at t = {}: the springs "
+            "chatter at their kinks",
+            t0));
+      }
+      double h = eta_ - s;
+      bool whole = true;
+      int R = 0;
+      collect_acting();
+      while (true) {
+        R = taylor(t0 + s, h, o_.max_series_terms, 0.5 * kEpsilon, true, resume);
+        resume = 0;
+        if (R < o_.max_series_terms) break;
+        h *= 0.5;
+        whole = false;
+        if (!(h > 0.0)) {
+          throw DivergenceError("pim-switching-banded: the Taylor series did not converge");
+        }
+      }
+      ++diagnostics_.pieces;
+      if (prepare_polynomial(R)) {
+        // A spring on its kink whose motion points to the other side: correct its mode (not a
+        // switch) and start the new mode's series from the same point.
+        for (Index j : flip_) set_mode(j, !(mode_[j] > 0.0));
+        continue;
+      }
+      const event_detail::SearchResult& r =
+          locator_.find_first_crossing(poly_, start_, 1.0, settings_);
+      diagnostics_.gap_samples += r.samples;
+      if (r.found) {
+        evaluate_series(R, r.at.t);
+        s = r.at.t >= 1.0 && whole ? eta_ : s + r.at.t * h;
+        for (Index j : r.springs) toggle(j);
+      } else {
+        evaluate_series(R, 1.0);
+        s = whole ? eta_ : s + h;
+      }
+      xs_[0].swap(vx_);
+      us_[0].swap(vu_);
+    }
+    for (Index i = 0; i < n_; ++i) {
+      state_[2 * i] = xs_[0][i];
+      state_[2 * i + 1] = us_[0][i];
+    }
+    finish_step();
+  }
+
+  void toggle(Index j) {
+    set_mode(j, !(mode_[j] > 0.0));
+    ++diagnostics_.switches;
+    ++stats_.kink_events;
+  }
+
+  void finish_step() {
+    ++steps_;
+    ++stats_.steps;
+    ++diagnostics_.steps;
+    double largest = 0.0, largest_x = 0.0;
+    for (Index i = 0; i < n_; ++i) {
+      const double x = std::abs(state_[2 * i]), v = std::abs(state_[2 * i + 1]);
+      largest_x = std::max(largest_x, x);
+      largest = std::max({largest, x, v});
+      if (std::isnan(x) || std::isnan(v)) largest = std::numeric_limits<double>::infinity();
+    }
+    x_scale_ = std::max(x_scale_, largest_x);
+    if (!(largest <= o_.divergence_bound)) {
+      throw DivergenceError(fmt::format(
+          "the motion blew up at t = {}: largest |x| or |x'| is {} (divergence_bound {})",
+          time(), largest, o_.divergence_bound));
+    }
+  }
+
+  SwitchingPimOptions o_;
+  Index n_, m_;
+  int d_;
+  double eta_;
+  bool end_derivative_;
+  BandedLcpSolver solver_;
+  bool lcp_synced_ = false;
+  BandTruncation truncation_;
+  BandedMatrix transition_;                 // T, interleaved state
+  std::vector<HarmonicResponse> harmonics_; // interleaved
+  std::vector<BandedMatrix> correction_, correction_columns_;  // coefficients of p_r (2n x m)
+  BandedMatrix phi_, phi_columns_;          // ... of P_{k+1}
+  BandedMatrix slope_, slope_columns_;      // ... of the end-slope correction
+  RowSparse stiffness_part_, damping_part_, force_part_, gap_rows_, spring_rows_;
+  Vector gaps_, stiffnesses_, spring_offset_, abs_row_sums_;
+  std::vector<LoadTerm> loads_;
+  double phase_sin_[16] = {}, phase_cos_[16] = {}, load_scale_[16] = {};
+
+  std::vector<Vector> xs_, us_, ps_, gw_;
+  std::vector<int> acting_;
+  Vector mode_, signs_;
+  Vector state_, bar_, acc_, half_, vx_, vu_;
+  Vector z_, q_, slope_guess_;
+  double origin_ = 0.0;
+  long steps_ = 0;
+  double x_scale_ = 0.0;
+  Vector position_, velocity_;
+  IntegratorStats stats_;
+  SwitchingPimDiagnostics diagnostics_;
+  PolynomialGaps poly_;
+  event_detail::EventLocator locator_;
+  GapSample start_;
+  event_detail::SearchSettings settings_;
+  std::vector<Index> flip_;
+};
+
+}  // namespace
+
+std::unique_ptr<SwitchingPim> make_banded_switching_pim(const GapStructure& structure,
+                                                        const BandedSwitchingPimOptions& options) {
+  std::string why;
+  if (!options.is_valid(&why)) throw InputError("banded switching pim options: " + why);
+  structure.validate();
+  if (structure.load_groups().size() > 16) {
+    throw InputError(fmt::format("loads: {} distinct frequencies; the switching PIM handles at "
+                                 "most 16",
+                                 structure.load_groups().size()));
+  }
+  const BandedLayout layout = banded_layout(structure);
+  if (!layout.diagonal_mass) {
+    throw InputError("banded switching pim: " + layout.why_not +
+                     "; the banded method needs a lumped mass (use make_switching_pim)");
+  }
+  return std::make_unique<BandedStepper>(structure, options);
+}
+
+}  // namespace pwl

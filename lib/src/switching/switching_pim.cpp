@@ -1,0 +1,1019 @@
+// The higher-order PIM of switching_pim.hpp: Hermite-Taylor force polynomial in smooth steps,
+// Taylor-series pieces with located switches in the steps where a spring changes state.
+#include "pwl/integrators/switching_pim.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <fmt/format.h>
+
+#include "event/event_location.hpp"
+#include "switching/switching_pim_detail.hpp"
+#include "pwl/errors.hpp"
+#include "integrators/fixed_step_count.hpp"
+#include "pwl/numerics/lcp_solver.hpp"
+#include "pwl/integrators/pim_step_operators.hpp"
+
+namespace pwl {
+
+bool SwitchingPimOptions::is_valid(std::string* why) const {
+  std::string scratch;
+  if (why == nullptr) why = &scratch;
+  if (!std::isfinite(step) || step <= 0.0) {
+    *why = fmt::format("step = {} must be positive and finite", step);
+    return false;
+  }
+  if (force_degree < 0 || force_degree > 8) {
+    *why = fmt::format("force_degree = {} must be in 0..8", force_degree);
+    return false;
+  }
+  if (lcp_solver != "block-pivoting" && lcp_solver != "lemke") {
+    *why = fmt::format("lcp_solver = \"{}\" must be \"block-pivoting\" or \"lemke\"", lcp_solver);
+    return false;
+  }
+  if (!(divergence_bound > 0.0)) {
+    *why = fmt::format("divergence_bound = {} must be positive", divergence_bound);
+    return false;
+  }
+  if (!(max_step_argument > 0.0)) {
+    *why = fmt::format("max_step_argument = {} must be positive", max_step_argument);
+    return false;
+  }
+  if (max_series_terms < 8 || max_series_terms > 200) {
+    *why = fmt::format("max_series_terms = {} must be in 8..200", max_series_terms);
+    return false;
+  }
+  return exponential.is_valid(why);
+}
+
+PolynomialForceIntegrals polynomial_force_integrals(const Matrix& H, double eta, const Matrix& G,
+                                                    int degree,
+                                                    const PreciseExponentialOptions& options) {
+  std::string why;
+  if (!options.is_valid(&why)) throw InputError("precise exponential options: " + why);
+  if (H.rows() != H.cols()) {
+    throw InputError(fmt::format("H is {}x{}: it must be square", H.rows(), H.cols()));
+  }
+  if (G.cols() > 0 && G.rows() != H.rows()) {
+    throw InputError(fmt::format("G has {} rows, H has {}", G.rows(), H.rows()));
+  }
+  if (!std::isfinite(eta) || eta <= 0.0) {
+    throw InputError(fmt::format("step = {} must be positive and finite", eta));
+  }
+  if (degree < 0 || degree > 12) {
+    throw InputError(fmt::format("degree = {} must be in 0..12", degree));
+  }
+  if (!H.allFinite() || !G.allFinite()) throw InputError("H or G has a non-finite entry");
+  const Index n = H.rows();
+  const Index m = G.cols();
+  const int count = degree + 1;
+  double tau = std::ldexp(eta, -options.doublings);
+
+  // Taylor series at τ: T_a = Σ_{k>=1} (Hτ)^k/k!, Ξ̂_r = Σ_k H^k G τ^{k+1} r!/(k+r+1)!.
+  Matrix Ta = Matrix::Zero(n, n);
+  Matrix power = Matrix::Identity(n, n);
+  Matrix HkG = G;
+  std::vector<Matrix> moments(static_cast<std::size_t>(count), Matrix::Zero(n, m));
+  for (int k = 0; k <= options.taylor_order; ++k) {
+    if (k > 0) {
+      power = power * H * (tau / k);
+      Ta += power;
+      HkG = H * HkG;
+    }
+    for (int r = 0; r < count; ++r) {
+      // τ^{k+1} r!/(k+r+1)! = τ^{k+1} / ((r+1)(r+2)...(r+k+1))
+      double c = 1.0;
+      for (int i = 1; i <= k + 1; ++i) c *= tau / (r + i);
+      moments[static_cast<std::size_t>(r)] += c * HkG;
+    }
+  }
+  // Binomial coefficients C(r, i).
+  std::vector<std::vector<double>> binomial(static_cast<std::size_t>(count));
+  for (int r = 0; r < count; ++r) {
+    auto& row = binomial[static_cast<std::size_t>(r)];
+    row.assign(static_cast<std::size_t>(r + 1), 1.0);
+    for (int i = 1; i < r; ++i) {
+      row[static_cast<std::size_t>(i)] = binomial[static_cast<std::size_t>(r - 1)][static_cast<std::size_t>(i - 1)] +
+                                        binomial[static_cast<std::size_t>(r - 1)][static_cast<std::size_t>(i)];
+    }
+  }
+  Matrix stacked(n, count * m);
+  for (int d = 0; d < options.doublings; ++d) {
+    for (int r = 0; r < count; ++r) stacked.middleCols(r * m, m) = moments[static_cast<std::size_t>(r)];
+    const Matrix TaX = Ta * stacked;
+    std::vector<Matrix> next(static_cast<std::size_t>(count));
+    for (int r = 0; r < count; ++r) {
+      const auto ru = static_cast<std::size_t>(r);
+      // T Ξ̂_r + Ξ̂_r = T_a Ξ̂_r + 2 Ξ̂_r, then the lower moments from expanding (u + τ)^r.
+      Matrix sum = TaX.middleCols(r * m, m) + 2.0 * moments[ru];
+      for (int i = 0; i < r; ++i) sum += binomial[ru][static_cast<std::size_t>(i)] * moments[static_cast<std::size_t>(i)];
+      next[ru] = std::ldexp(1.0, -r) * sum;
+    }
+    moments.swap(next);
+    Ta = 2.0 * Ta + Ta * Ta;
+    tau *= 2.0;
+  }
+  PolynomialForceIntegrals out;
+  out.transition = std::move(Ta);
+  out.transition.diagonal().array() += 1.0;
+  out.moments = std::move(moments);
+  return out;
+}
+
+namespace {
+
+using event_detail::GapSample;
+constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
+
+using switching_detail::PolynomialGaps;
+
+struct LoadTerm {
+  double omega;
+  Vector sin_part;  // M⁻¹ times the load's sin part (velocity rows)
+  Vector cos_part;
+};
+
+// Everything the stepper needs, at run-time size; the stepper copies it into its own types.
+struct Operators {
+  double eta = 0.0;
+  int degree = 0;
+  Matrix transition;
+  std::vector<Matrix> correction;  // the coefficient of p_r, r = 0..d
+  Matrix phi;                      // the coefficient of P_{k+1}
+  Matrix slope;                    // the coefficient of η P'_{k+1} (end_derivative)
+  bool end_derivative = false;
+  std::vector<HarmonicResponse> harmonics;
+  Matrix stiffness_part, damping_part, force_part;  // -M⁻¹K, -M⁻¹C, -M⁻¹W
+  Matrix gap_rows;                                  // W^T
+  Vector gaps, stiffnesses;
+  std::vector<LoadTerm> loads;
+  Matrix lcp_matrix;
+  double step_argument = 0.0;
+};
+
+Operators make_operators(const GapStructure& structure, const SwitchingPimOptions& o) {
+  structure.validate();
+  Operators ops;
+  ops.eta = o.step;
+  ops.degree = o.force_degree;
+  const Index n = structure.dofs();
+  const Index m = structure.spring_count();
+  const Eigen::LLT<Matrix> mass{Matrix(structure.mass)};
+  const Matrix W = structure.spring_directions();
+  ops.stiffness_part = -mass.solve(Matrix(structure.stiffness));
+  ops.damping_part = -mass.solve(Matrix(structure.damping));
+  ops.force_part = m > 0 ? Matrix(-mass.solve(W)) : Matrix(n, 0);
+  ops.gap_rows = W.transpose();
+  ops.gaps = structure.spring_gaps();
+  ops.stiffnesses = structure.spring_stiffnesses();
+  for (const LoadGroup& g : structure.load_groups()) {
+    ops.loads.push_back({g.omega, mass.solve(g.sin_part), mass.solve(g.cos_part)});
+  }
+
+  // η ω_max with ω_max bounded from |λ|² <= ||M⁻¹K_all|| + |λ| ||M⁻¹C|| (every spring touching).
+  const Matrix k_all = -ops.stiffness_part -
+                       ops.force_part * ops.stiffnesses.asDiagonal() * ops.gap_rows;
+  const double kn = k_all.lpNorm<Eigen::Infinity>();
+  const double cn = ops.damping_part.lpNorm<Eigen::Infinity>();
+  ops.step_argument = o.step * 0.5 * (cn + std::sqrt(cn * cn + 4.0 * kn));
+  if ((o.force_degree > 0 || o.end_derivative) && ops.step_argument > o.max_step_argument) {
+    throw InputError(fmt::format(
+        "step = {}: η ω_max = {:.3g} exceeds max_step_argument = {} (the contact is too stiff "
+        "for the force derivatives at this step); use a step below {:.3g}, or force_degree = 0 "
+        "with end_derivative = false",
+        o.step, ops.step_argument, o.max_step_argument,
+        o.step * o.max_step_argument / ops.step_argument));
+  }
+
+  Matrix G = Matrix::Zero(2 * n, m);
+  if (m > 0) G.bottomRows(n) = ops.force_part;
+  const int d = o.force_degree;
+  ops.end_derivative = o.end_derivative;
+  const PolynomialForceIntegrals pfi = polynomial_force_integrals(
+      state_matrix(structure), o.step, G, d + (o.end_derivative ? 2 : 1), o.exponential);
+  ops.transition = pfi.transition;
+  const auto moment = [&](int r) -> const Matrix& { return pfi.moments[static_cast<std::size_t>(r)]; };
+  if (!o.end_derivative) {
+    // P(σ) = Σ_{r<=d} p_r σ^r + (P_end - Σ p_r) σ^{d+1}.
+    ops.phi = moment(d + 1);
+    for (int r = 0; r <= d; ++r) ops.correction.push_back(moment(r) - ops.phi);
+    ops.slope = Matrix::Zero(2 * n, m);
+  } else {
+    // P(σ) = Σ_{r<=d} p_r σ^r + α σ^{d+1} + β σ^{d+2} with P(1) = P_end and P'(1) = q_end
+    // (η P' at the end): β = q_end - Σ r p_r - (d+1)(P_end - Σ p_r), α = P_end - Σ p_r - β,
+    // so with Δ = Ξ̂_{d+2} - Ξ̂_{d+1} the step is Σ_r (Ξ̂_r - Ξ̂_{d+1} + (d+1-r) Δ) p_r
+    // + (Ξ̂_{d+1} - (d+1) Δ) P_end + Δ q_end.
+    const Matrix delta = moment(d + 2) - moment(d + 1);
+    ops.phi = moment(d + 1) - (d + 1) * delta;
+    for (int r = 0; r <= d; ++r) {
+      ops.correction.push_back(moment(r) - moment(d + 1) + (d + 1 - r) * delta);
+    }
+    ops.slope = delta;
+  }
+  // The harmonic responses are the plain PIM's (exact for any step).
+  ops.harmonics = make_pim_step_operators(structure, o.step, o.exponential).harmonics;
+  ops.lcp_matrix = Matrix::Identity(m, m) -
+                   ops.stiffnesses.asDiagonal() * ops.gap_rows * ops.phi.topRows(n);
+  return ops;
+}
+
+template <int Dofs, int Springs>
+class Stepper final : public SwitchingPim {
+  static constexpr int kState = Dofs == Eigen::Dynamic ? Eigen::Dynamic : 2 * Dofs;
+  using State = Eigen::Matrix<double, kState, 1>;
+  using Half = Eigen::Matrix<double, Dofs, 1>;
+  using Force = Eigen::Matrix<double, Springs, 1>;
+  using StateSquare = Eigen::Matrix<double, kState, kState>;
+  using StateForce = Eigen::Matrix<double, kState, Springs>;
+  using HalfSquare = Eigen::Matrix<double, Dofs, Dofs>;
+  using HalfForce = Eigen::Matrix<double, Dofs, Springs>;
+  using ForceHalf = Eigen::Matrix<double, Springs, Dofs>;
+
+ public:
+  Stepper(const Operators& ops, const SwitchingPimOptions& o)
+      : o_(o), n_(ops.stiffness_part.rows()), m_(ops.gap_rows.rows()), d_(ops.degree),
+        eta_(ops.eta), solver_(make_lcp_solver(o.lcp_solver)) {
+    if ((Dofs != Eigen::Dynamic && n_ != Dofs) || (Springs != Eigen::Dynamic && m_ != Springs)) {
+      throw InputError(fmt::format("a {}-dof, {}-spring structure given to a stepper for {} dofs "
+                                   "and {} springs",
+                                   n_, m_, Dofs, Springs));
+    }
+    transition_ = ops.transition;
+    for (const Matrix& c : ops.correction) correction_.push_back(c);
+    if (ops.end_derivative) {
+      // The predicted end slope Σ_{r=1}^{d+1} r p_r enters through slope; fold it into the
+      // coefficients of the p_r (and one more for p_{d+1}).
+      for (int r = 1; r <= d_; ++r) correction_[static_cast<std::size_t>(r)] += r * ops.slope;
+      correction_.push_back((d_ + 1) * ops.slope);
+    }
+    phi_ = ops.phi;
+    slope_ = ops.slope;
+    end_derivative_ = ops.end_derivative;
+    for (const HarmonicResponse& h : ops.harmonics) {
+      harmonics_.push_back({h.omega, h.sin_response, h.cos_response});
+    }
+    stiffness_part_ = ops.stiffness_part;
+    damping_part_ = ops.damping_part;
+    force_part_ = ops.force_part;
+    gap_rows_ = ops.gap_rows;
+    gaps_ = ops.gaps;
+    stiffnesses_ = ops.stiffnesses;
+    spring_rows_ = ops.stiffnesses.asDiagonal() * ops.gap_rows;  // K2 W^T
+    spring_offset_ = ops.stiffnesses.cwiseProduct(ops.gaps);     // K2 Δ
+    abs_gap_rows_ = ops.gap_rows.cwiseAbs();
+    for (const LoadTerm& l : ops.loads) loads_.push_back({l.omega, l.sin_part, l.cos_part});
+    diagnostics_.step_argument = ops.step_argument;
+    std::string why;
+    if (m_ > 0 && !is_p_matrix(ops.lcp_matrix, &why)) {
+      throw InputError(fmt::format("step = {}: the step's LCP matrix is not a P-matrix ({}); use "
+                                   "a smaller step",
+                                   eta_, why));
+    }
+    if (m_ > 0) solver_->set_matrix(ops.lcp_matrix);
+    lcp_matrix_ = ops.lcp_matrix;
+    const double mmax = m_ > 0 ? lcp_matrix_.cwiseAbs().maxCoeff() : 0.0;
+    lcp_scale_ = mmax > 0.0 ? mmax : 1.0;
+    inline_lcp_ = o.lcp_solver == "block-pivoting";
+    // The per-mode operators take at most one load group (its harmonic response and load in
+    // the same group); more frequencies take the Taylor recursion in every step.
+    mode_cached_ = kModeCache && loads_.size() <= 1 && harmonics_.size() == loads_.size() &&
+                   m_ <= kMaxCachedSprings;
+    if (mode_cached_) mode_ops_.resize(std::size_t{1} << m_);
+    for (const Load& l : loads_) {
+      rotations_.push_back({std::cos(l.omega * eta_), std::sin(l.omega * eta_)});
+    }
+    phases_ = Phases(0.0, 0.0, 1.0);
+    const int terms = std::max(o.max_series_terms, d_ + 2) + 1;
+    xs_.assign(static_cast<std::size_t>(terms), Half::Zero(n_));
+    us_.assign(static_cast<std::size_t>(terms), Half::Zero(n_));
+    ps_.assign(static_cast<std::size_t>(terms), Force::Zero(m_));
+    gw_.assign(static_cast<std::size_t>(terms), Force::Zero(m_));
+    mode_ = Force::Zero(m_);
+    signs_ = Force::Constant(m_, -1.0);
+    state_ = State::Zero(2 * n_);
+    bar_ = state_;
+    z_ = Force::Zero(m_);
+    lcp_x_ = z_;
+    scaled_velocity_ = Half::Zero(n_);
+    w_ = z_;
+    q_ = z_;
+    position_ = Vector::Zero(n_);
+    velocity_ = position_;
+    anchor_phases();
+  }
+
+  std::string name() const override {
+    return fmt::format("pim-{} (order {}{}, step {:.6g})", o_.locate_switches ? "switching" : "hermite",
+                       d_ + (end_derivative_ ? 3 : 2), o_.locate_switches ? ", located switches" : "",
+                       eta_);
+  }
+  Index dofs() const override { return n_; }
+  double time() const override { return origin_ + static_cast<double>(steps_) * eta_; }
+  const Vector& position() const override { return position_; }
+  const Vector& velocity() const override { return velocity_; }
+  IntegratorStats stats() const override { return stats_; }
+  SwitchingPimDiagnostics diagnostics() const override { return diagnostics_; }
+
+  void set_state(double t, const Vector& x, const Vector& v) override {
+    if (x.size() != n_ || v.size() != n_) {
+      throw InputError(fmt::format("state has {} displacements and {} velocities, expected {}",
+                                   x.size(), v.size(), n_));
+    }
+    if (!std::isfinite(t) || !x.allFinite() || !v.allFinite()) {
+      throw InputError(fmt::format("initial state at t = {} has a non-finite entry", t));
+    }
+    origin_ = t;
+    steps_ = 0;
+    state_.head(n_) = x;
+    state_.tail(n_) = v;
+    // Touching where the gap is closed; a spring exactly at its kink starts slack and the first
+    // step settles it from its derivatives.
+    const Force g = gap_rows_ * state_.head(n_) - gaps_;
+    for (Index j = 0; j < m_; ++j) set_mode(j, g[j] > 0.0);
+    x_scale_ = x.cwiseAbs().maxCoeff();
+    anchor_phases();
+    sync();
+  }
+
+  void advance_to(double t_end, const StepObserver& observer) override {
+    const long count = detail::fixed_step_count(t_end, time(), eta_);
+    for (long k = 0; k < count; ++k) {
+      step();
+      if (observer) {
+        sync();
+        observer(time(), position_, velocity_);
+      }
+    }
+    sync();
+  }
+
+ private:
+  struct Harmonic {
+    double omega;
+    State sin_response, cos_response;
+  };
+  struct Load {
+    double omega;
+    Half sin_part, cos_part;
+  };
+  struct Rotation {
+    double cos_step, sin_step;  // cos ωη, sin ωη
+  };
+  // The phases sin ωt, cos ωt of the (at most one) load group and 1, and their coefficients.
+  using Phases = Eigen::Vector3d;
+  using StateLoad = Eigen::Matrix<double, kState, 3>;
+  using ForceLoad = Eigen::Matrix<double, Springs, 3>;
+  using ForceStateRows = Eigen::Matrix<double, Springs, kState, Eigen::RowMajor>;
+  using ForceSquare = Eigen::Matrix<double, Springs, Springs>;
+  // The smooth step in one mode, affine in the state v and in the phases (sin ωt, cos ωt of
+  // the load group, 0 and 0 without one, and 1):
+  //   bar = bar v + bar_load phases (the predicted end slope folded in),
+  //   gw_r = gap[r] v + gap_load[r] phases (r = 0..d+1, the gap coefficients of the screen;
+  //          row-major, so that each entry is one contiguous dot product; r = 0, 1 do not
+  //          depend on the mode and the step computes them directly),
+  //   p_r = touching gw_r for r >= 1 (touching = mode K2),
+  //   slope at the end = slope_rows x'_{k+1} (η mode K2 W^T),
+  // and the LCP transform of the mode as active set.
+  struct ModeOps {
+    StateSquare bar;
+    StateLoad bar_load;
+    std::vector<ForceStateRows> gap;
+    std::vector<ForceLoad> gap_load;
+    Force touching;
+    ForceHalf slope_rows;
+    ForceSquare lcp_transform;
+    bool lcp_ready = false;
+  };
+
+  // The displacement and velocity halves of a state, as fixed-size blocks when the sizes are
+  // fixed (a run-time-sized block would send the products to Eigen's general kernels).
+  template <class V>
+  static auto upper(V& v, Index n) {
+    if constexpr (Dofs == Eigen::Dynamic) {
+      return v.head(n);
+    } else {
+      return v.template head<Dofs>();
+    }
+  }
+  template <class V>
+  static auto lower(V& v, Index n) {
+    if constexpr (Dofs == Eigen::Dynamic) {
+      return v.tail(n);
+    } else {
+      return v.template tail<Dofs>();
+    }
+  }
+
+  // A · x: coefficient-wise and fully unrolled for the fixed sizes (Eigen's general
+  // matrix-vector kernel costs more than the arithmetic at these sizes), the kernel otherwise.
+  template <class A, class X>
+  static auto mul(const A& a, const X& x) {
+    if constexpr (Dofs == Eigen::Dynamic) {
+      return a * x;
+    } else {
+      return a.lazyProduct(x);
+    }
+  }
+
+  void set_mode(Index j, bool on) {
+    mode_[j] = on ? 1.0 : 0.0;
+    signs_[j] = on ? 1.0 : -1.0;
+    if (j < 64) {
+      const std::uint64_t bit = std::uint64_t{1} << j;
+      mode_mask_ = on ? (mode_mask_ | bit) : (mode_mask_ & ~bit);
+    }
+  }
+
+  void sync() {
+    position_ = state_.head(n_);
+    velocity_ = state_.tail(n_);
+  }
+
+  // Scaled Taylor coefficients of the motion in the current mode about time t for a step h:
+  // xs_[r] = x^{(r)} h^r / r!, us_[r] the same for x', ps_[r] = P^{(r)} h^r / r!, gw_[r] =
+  // W^T xs_[r]. Computes xs_ and gw_ up to `last`, us_ and ps_ up to last - 1. When tol > 0,
+  // stops early once two consecutive terms are below tol times the largest; returns the index
+  // of the last term computed.
+  // With first > 0 the terms up to `first` (velocity and force up to first - 1) are those of
+  // a call with the same t, h and v that stopped there, and the series continues from them.
+  int taylor(double t, double h, const State& v, int last, double tol, bool full = true,
+             int first = 0) {
+    double largest = 0.0;
+    if (first == 0) {
+      xs_[0] = upper(v, n_);
+      us_[0] = lower(v, n_);
+      gw_[0].noalias() = mul(gap_rows_, xs_[0]);
+      for (std::size_t g = 0; g < loads_.size(); ++g) {
+        phase_sin_[g] = std::sin(loads_[g].omega * t);
+        phase_cos_[g] = std::cos(loads_[g].omega * t);
+        load_scale_[g] = 1.0;
+      }
+    }
+    for (int r = 0; r < first; ++r) {
+      largest = std::max({largest, xs_[static_cast<std::size_t>(r)].cwiseAbs().maxCoeff(),
+                          us_[static_cast<std::size_t>(r)].cwiseAbs().maxCoeff()});
+    }
+    largest = std::max({largest, xs_[static_cast<std::size_t>(first)].cwiseAbs().maxCoeff(),
+                        first == 0 ? us_[0].cwiseAbs().maxCoeff() : 0.0});
+    double previous = largest;
+    for (int r = first; r < last; ++r) {
+      const auto ru = static_cast<std::size_t>(r);
+      ps_[ru] = mode_.cwiseProduct(stiffnesses_.cwiseProduct(gw_[ru]));
+      if (r == 0) ps_[ru] -= mode_.cwiseProduct(spring_offset_);
+      const double f = h / (r + 1);
+      xs_[ru + 1] = f * us_[ru];
+      gw_[ru + 1].noalias() = mul(gap_rows_, xs_[ru + 1]);
+      if (!full && r + 1 == last) break;  // the last velocity term is not needed
+      Half acc = mul(stiffness_part_, xs_[ru]);
+      acc.noalias() += mul(damping_part_, us_[ru]);
+      acc.noalias() += mul(force_part_, ps_[ru]);
+      for (std::size_t g = 0; g < loads_.size(); ++g) {
+        // d^r/dt^r of sin and cos at ωt, scaled by (ωh)^r / r!: the cycle (S, C, -S, -C).
+        const double S = phase_sin_[g], C = phase_cos_[g];
+        double ds = 0.0, dc = 0.0;
+        switch (r % 4) {
+          case 0: ds = S; dc = C; break;
+          case 1: ds = C; dc = -S; break;
+          case 2: ds = -S; dc = -C; break;
+          default: ds = -C; dc = S; break;
+        }
+        const double scale = load_scale_[g];
+        if (scale != 0.0) acc += scale * (ds * loads_[g].sin_part + dc * loads_[g].cos_part);
+        load_scale_[g] = scale * loads_[g].omega * h / (r + 1);
+      }
+      us_[ru + 1] = f * acc;
+      if (tol > 0.0) {
+        const double size =
+            std::max(xs_[ru + 1].cwiseAbs().maxCoeff(), us_[ru + 1].cwiseAbs().maxCoeff());
+        largest = std::max(largest, size);
+        if (r + 1 >= 4 && size + previous <= tol * largest) return r + 1;
+        previous = size;
+      }
+    }
+    return last;
+  }
+
+  // Σ_r a_r σ^r for the state.
+  void evaluate_series(int R, double sigma, State& v) const {
+    Half x = xs_[static_cast<std::size_t>(R)];
+    Half u = us_[static_cast<std::size_t>(R)];
+    for (int r = R - 1; r >= 0; --r) {
+      x = x * sigma + xs_[static_cast<std::size_t>(r)];
+      u = u * sigma + us_[static_cast<std::size_t>(r)];
+    }
+    upper(v, n_) = x;
+    lower(v, n_) = u;
+  }
+
+  double kink_tolerance(Index j, const State& v) const {
+    return 64.0 * kEpsilon *
+           (std::abs(gaps_[j]) + abs_gap_rows_.row(j).dot(v.head(n_).cwiseAbs()) +
+            abs_gap_rows_.row(j).sum() * x_scale_);
+  }
+
+  // The gap polynomial of the coefficients gw_[0..R] (mode-signed) on σ in [0, 1]; settles the
+  // springs on their kink at σ = 0. Returns true when a spring must switch at σ = 0 (its
+  // first derivative points away from its mode); fills certified_until_ and tolerance_.
+  bool prepare_polynomial(int R, const State& v) {
+    poly_.c.resize(m_, R + 1);
+    for (int r = 0; r <= R; ++r) {
+      const Force col = signs_.cwiseProduct(gw_[static_cast<std::size_t>(r)] -
+                                            (r == 0 ? gaps_ : Force(Force::Zero(m_))));
+      poly_.c.col(r) = col;
+    }
+    start_ = GapSample();
+    poly_.sample(start_, 0.0, start_);
+    // The bounds of a polynomial are tight: try the whole piece at once and split only where
+    // the envelopes cannot decide.
+    settings_.nominal_spacing = 1.0;
+    settings_.max_spacing = 0.0;
+    settings_.min_width = 64.0 * kEpsilon;
+    settings_.tolerance = Vector::Zero(m_);
+    settings_.certified_until = Vector::Constant(m_, -std::numeric_limits<double>::infinity());
+    flip_.clear();
+    for (Index j = 0; j < m_; ++j) {
+      const double tol = kink_tolerance(j, v);
+      if (start_.e[j] > tol) continue;
+      double until = 0.0;
+      const int verdict =
+          locator_.certify_departure(poly_, start_, j, tol, 1.0, settings_.min_width, &until);
+      if (verdict < 0) {
+        flip_.push_back(j);
+      } else {
+        settings_.certified_until[j] = until;
+        if (verdict == 0) settings_.tolerance[j] = tol;
+      }
+    }
+    return !flip_.empty();
+  }
+
+  // One step. With fixed sizes and at most one load group, the smooth step uses the operators
+  // of the current mode, in which everything before the LCP is affine in the state and in
+  // sin ωt, cos ωt (see ModeOps); otherwise, and for every switching step, the Taylor recursion
+  // of taylor().
+  void step() {
+    if (mode_cached_) {
+      step_cached();
+    } else {
+      step_direct();
+    }
+  }
+
+  // The smooth step on the mode's combined operators: the same quantities as step_direct()
+  // computes through the Taylor recursion, up to rounding.
+  void step_cached() {
+    const double t = time();
+    const ModeOps& op = mode_ops();
+    // The first two gap terms, W^T x and η W^T x', are the same in every mode.
+    gw_[0].noalias() = mul(gap_rows_, upper(state_, n_));
+    scaled_velocity_ = eta_ * lower(state_, n_);
+    gw_[1].noalias() = mul(gap_rows_, scaled_velocity_);
+    const auto terms = static_cast<std::size_t>(d_ + 2);
+    for (std::size_t r = 2; r < terms; ++r) {
+      gw_[r].noalias() = mul(op.gap[r], state_);
+      gw_[r].noalias() += mul(op.gap_load[r], phases_);
+    }
+    if (o_.locate_switches && screen_fails()) {
+      ++diagnostics_.screened;
+      taylor(t, eta_, state_, d_ + 1, 0.0, false);  // the data switching_step() continues
+      switching_step(t);
+      return;
+    }
+    bar_.noalias() = mul(op.bar, state_);
+    bar_.noalias() += mul(op.bar_load, phases_);
+    if (end_derivative_) {
+      // The end slope η P'(t_{k+1}) the start's Taylor data predict, Σ_{r=1}^{d+1} r p_r with
+      // p_r = mode K2 gw_r for r >= 1.
+      slope_guess_ = static_cast<double>(d_ + 1) * gw_[static_cast<std::size_t>(d_ + 1)];
+      for (int r = 1; r <= d_; ++r) {
+        slope_guess_ += static_cast<double>(r) * gw_[static_cast<std::size_t>(r)];
+      }
+      slope_guess_ = op.touching.cwiseProduct(slope_guess_);
+    }
+    q_.noalias() = spring_offset_ - mul(spring_rows_, upper(bar_, n_));
+    if (m_ > 0 && !solve_warm(op)) {
+      z_ = mode_;
+      stats_.lcp_pivots += solver_->solve(q_, z_, w_).pivots;
+    }
+    if (o_.locate_switches) {
+      for (Index j = 0; j < m_; ++j) {
+        if ((z_[j] > 0.0) != (mode_[j] > 0.0)) {
+          ++diagnostics_.lcp_mismatches;
+          taylor(t, eta_, state_, d_ + 1, 0.0, false);
+          switching_step(t);
+          return;
+        }
+      }
+    } else {
+      for (Index j = 0; j < m_; ++j) set_mode(j, z_[j] > 0.0);
+    }
+    // Φ z and the slope correction over the springs that carry a force only: the others'
+    // columns are multiplied by zero (few springs touch at a time).
+    state_ = bar_;
+    for (Index j = 0; j < m_; ++j) {
+      if (z_[j] != 0.0) state_ += z_[j] * phi_.col(j);
+    }
+    if (end_derivative_ && o_.locate_switches && mode_mask_ != 0) {
+      // Correct with the slope the new state gives (the mode is the same at both ends); both
+      // slopes vanish on the slack springs.
+      slope_guess_ = mul(op.slope_rows, lower(state_, n_)) - slope_guess_;
+      for (Index j = 0; j < m_; ++j) {
+        if (mode_[j] > 0.0) state_ += slope_guess_[j] * slope_.col(j);
+      }
+    }
+    finish_step();
+  }
+
+  // The LCP for q_ when the block-pivoting solver's first iterate from the warm start (the
+  // current mode) already solves it, as it does in every smooth step: z = 0 when q is
+  // non-negative, else x = T_A q with the mode's transform. The same test and tolerances as the
+  // solver (lcp_solver.cpp), without its input checks and the virtual call. Returns false
+  // (z_ untouched) when it cannot decide: another solver, a non-finite q, or an infeasible
+  // iterate, which the solver then pivots away.
+  bool solve_warm(const ModeOps& op) {
+    if (!inline_lcp_ || !op.lcp_ready) return false;
+    double qmax = 0.0, qmin = std::numeric_limits<double>::infinity();
+    for (Index i = 0; i < m_; ++i) {
+      const double v = q_[i];
+      if (!std::isfinite(v)) return false;
+      qmax = std::max(qmax, std::abs(v));
+      qmin = std::min(qmin, v);
+    }
+    const double tol_w = kLcpFeasTol * qmax;
+    const double tol_z = tol_w / lcp_scale_;
+    if (qmin >= -tol_w) {  // z = 0 solves it
+      z_.setZero();
+      return true;
+    }
+    lcp_x_.noalias() = mul(op.lcp_transform, q_);
+    for (Index i = 0; i < m_; ++i) {
+      const double tol = mode_[i] > 0.0 ? tol_z : tol_w;
+      if (lcp_x_[i] < -tol) return false;
+    }
+    for (Index i = 0; i < m_; ++i) z_[i] = mode_[i] > 0.0 ? std::max(lcp_x_[i], 0.0) : 0.0;
+    return true;
+  }
+
+  void step_direct() {
+    const double t = time();
+    // Taylor data of the force over the step (and one more gap term for the screen).
+    taylor(t, eta_, state_, d_ + 1, 0.0, false);
+    if (o_.locate_switches && screen_fails()) {
+      // A spring may switch in this step: follow it with the series, which locates the switch
+      // if there is one and is exact to rounding either way.
+      ++diagnostics_.screened;
+      switching_step(t);
+      return;
+    }
+    bar_.noalias() = mul(transition_, state_);
+    // The load phases at t were computed by taylor(); the groups are in the same order.
+    for (std::size_t g = 0; g < harmonics_.size(); ++g) {
+      bar_ += phase_sin_[g] * harmonics_[g].sin_response + phase_cos_[g] * harmonics_[g].cos_response;
+    }
+    if (end_derivative_) {
+      // The end slope η P'(t_{k+1}) as the start's Taylor data predict it (one more term).
+      const auto last = static_cast<std::size_t>(d_ + 1);
+      ps_[last] = mode_.cwiseProduct(stiffnesses_.cwiseProduct(gw_[last]));
+      slope_guess_ = static_cast<double>(d_ + 1) * ps_[last];
+      for (int r = 1; r <= d_; ++r) slope_guess_ += static_cast<double>(r) * ps_[static_cast<std::size_t>(r)];
+    }
+    for (std::size_t r = 0; r < correction_.size(); ++r) bar_.noalias() += mul(correction_[r], ps_[r]);
+    q_.noalias() = spring_offset_ - mul(spring_rows_, upper(bar_, n_));
+    z_ = mode_;
+    if (m_ > 0) stats_.lcp_pivots += solver_->solve(q_, z_, w_).pivots;
+    if (o_.locate_switches) {
+      for (Index j = 0; j < m_; ++j) {
+        if ((z_[j] > 0.0) != (mode_[j] > 0.0)) {
+          ++diagnostics_.lcp_mismatches;
+          switching_step(t);
+          return;
+        }
+      }
+    } else {
+      for (Index j = 0; j < m_; ++j) set_mode(j, z_[j] > 0.0);
+    }
+    state_ = bar_;
+    state_.noalias() += mul(phi_, z_);
+    if (end_derivative_ && o_.locate_switches) {
+      // Correct with the slope the new state gives (the mode is the same at both ends).
+      slope_guess_ = eta_ * mode_.cwiseProduct(stiffnesses_.cwiseProduct(mul(gap_rows_, lower(state_, n_)))) - slope_guess_;
+      state_.noalias() += mul(slope_, slope_guess_);
+    }
+    finish_step();
+  }
+
+  // True when some gap polynomial might reach zero on the step. On σ in [0, 1],
+  // e(σ) >= e_0 + e_1 σ - S σ² with S the sum of |e_r| for r >= 2; that concave lower bound is
+  // positive on [0, 1] when it is positive at both ends.
+  bool screen_fails() const {
+    for (Index j = 0; j < m_; ++j) {
+      const double e0 = signs_[j] * (gw_[0][j] - gaps_[j]);
+      const double e1 = signs_[j] * gw_[1][j];
+      double rest = 0.0;
+      for (int r = 2; r <= d_ + 1; ++r) rest += std::abs(gw_[static_cast<std::size_t>(r)][j]);
+      if (!(e0 > 0.0 && e0 + e1 - rest > 0.0)) return true;
+    }
+    return false;
+  }
+
+  // The step redone in pieces: each piece follows the Taylor series of the current mode up to
+  // the first located switch, or to the end of the step.
+  // On entry the Taylor data of the whole step (up to order d_ + 1, from step()) are in the
+  // buffers; the first piece continues that series instead of starting again.
+  void switching_step(double t0) {
+    ++diagnostics_.switching_steps;
+    State v = state_;
+    double s = 0.0;
+    int guard = 0;
+    int resume = d_;
+    while (s < eta_) {
+      if (++guard > 10000) {
+        throw DivergenceError(fmt::format(
+            "pim-switching: more than 10000 pieces in the step at t = {}: the springs chatter "
+            "at their kinks",
+            t0));
+      }
+      double h = eta_ - s;
+      bool whole = true;
+      int R = 0;
+      while (true) {
+        R = taylor(t0 + s, h, v, o_.max_series_terms, 0.5 * kEpsilon, true, resume);
+        resume = 0;
+        if (R < o_.max_series_terms) break;
+        h *= 0.5;
+        whole = false;
+        if (!(h > 0.0)) throw DivergenceError("pim-switching: the Taylor series did not converge");
+      }
+      ++diagnostics_.pieces;
+      if (prepare_polynomial(R, v)) {
+        // A spring on its kink whose motion points to the other side: its mode was a guess (a
+        // start exactly at the kink) or it only touched; correct it, not counted as a switch.
+        for (Index j : flip_) set_mode(j, !(mode_[j] > 0.0));
+        continue;  // the new mode's series from the same point
+      }
+      const event_detail::SearchResult& r =
+          locator_.find_first_crossing(poly_, start_, 1.0, settings_);
+      diagnostics_.gap_samples += r.samples;
+      if (r.found) {
+        evaluate_series(R, r.at.t, v);
+        s = r.at.t >= 1.0 && whole ? eta_ : s + r.at.t * h;
+        for (Index j : r.springs) toggle(j);
+      } else {
+        evaluate_series(R, 1.0, v);
+        s = whole ? eta_ : s + h;
+      }
+    }
+    state_ = v;
+    finish_step();
+  }
+
+  void toggle(Index j) {
+    set_mode(j, !(mode_[j] > 0.0));
+    ++diagnostics_.switches;
+    ++stats_.kink_events;
+  }
+
+  void finish_step() {
+    ++steps_;
+    ++stats_.steps;
+    ++diagnostics_.steps;
+    advance_phases();
+    const double largest = state_.cwiseAbs().maxCoeff();
+    x_scale_ = std::max(x_scale_, upper(state_, n_).cwiseAbs().maxCoeff());
+    if (!(largest <= o_.divergence_bound)) {
+      throw DivergenceError(fmt::format(
+          "the motion blew up at t = {}: largest |x| or |x'| is {} (divergence_bound {})",
+          time(), largest, o_.divergence_bound));
+    }
+  }
+
+  // sin ωt and cos ωt of the load group (the per-mode path takes at most one) at the step
+  // start, in phases_. Advanced by the fixed rotation through ωη each step and re-anchored to
+  // std::sin, std::cos every kReanchorSteps steps, so the rotation's rounding stays within a
+  // few ulps (as the plain PIM's propagator does).
+  void anchor_phases() {
+    if (!mode_cached_ || loads_.empty()) return;
+    const double t = time();
+    phases_[0] = std::sin(loads_[0].omega * t);
+    phases_[1] = std::cos(loads_[0].omega * t);
+  }
+
+  void advance_phases() {
+    if (!mode_cached_ || loads_.empty()) return;
+    if (steps_ % kReanchorSteps == 0) {
+      anchor_phases();
+      return;
+    }
+    const double sn = phases_[0], cs = phases_[1];
+    const Rotation& rot = rotations_[0];
+    phases_[0] = sn * rot.cos_step + cs * rot.sin_step;
+    phases_[1] = cs * rot.cos_step - sn * rot.sin_step;
+  }
+
+  // The operators of the current mode, built the first time the mode is met.
+  const ModeOps& mode_ops() {
+    std::unique_ptr<ModeOps>& slot = mode_ops_[static_cast<std::size_t>(mode_mask_)];
+    if (!slot) slot = build_mode_ops();
+    return *slot;
+  }
+
+  // For the current mode, the smooth step's affine maps, found by running the recursion of
+  // taylor() (h = η, terms up to d + 1) on the columns of [I_2n, phase terms]: the column of
+  // sin ωt (cos ωt) of the load group is the response to that phase, the last column the
+  // constant part (the spring offsets K2 Δ in p_0).
+  std::unique_ptr<ModeOps> build_mode_ops() const {
+    const Index n = n_, m = m_;
+    const auto groups = static_cast<Index>(loads_.size());
+    const Index cols = 2 * n + 2 * groups + 1;
+    const Index first_phase = 2 * n, constant = cols - 1;
+    const Vector mode = mode_;
+    const Vector touching = mode.cwiseProduct(Vector(stiffnesses_));  // mode K2
+    const Matrix W_t = gap_rows_;
+    const Matrix K_part = stiffness_part_, C_part = damping_part_, F_part = force_part_;
+    const auto terms = static_cast<std::size_t>(d_ + 2);
+    std::vector<Matrix> xs(terms), us(terms), ps(terms), gw(terms);
+    xs[0] = Matrix::Zero(n, cols);
+    xs[0].leftCols(n).setIdentity();
+    us[0] = Matrix::Zero(n, cols);
+    us[0].middleCols(n, n).setIdentity();
+    gw[0] = W_t * xs[0];
+    std::vector<double> scale(loads_.size(), 1.0);
+    for (int r = 0; r <= d_; ++r) {
+      const auto ru = static_cast<std::size_t>(r);
+      ps[ru] = touching.asDiagonal() * gw[ru];
+      if (r == 0) ps[ru].col(constant) -= mode.cwiseProduct(Vector(spring_offset_));
+      const double f = eta_ / (r + 1);
+      xs[ru + 1] = f * us[ru];
+      gw[ru + 1] = W_t * xs[ru + 1];
+      if (r == d_) break;
+      Matrix acc = K_part * xs[ru] + C_part * us[ru] + F_part * ps[ru];
+      for (std::size_t g = 0; g < loads_.size(); ++g) {
+        // The cycle (S, C, -S, -C) of taylor() as coefficients of sin ωt and cos ωt.
+        const Index cs = first_phase + 2 * static_cast<Index>(g), cc = cs + 1;
+        const Vector sp = loads_[g].sin_part, cp = loads_[g].cos_part;
+        const double a = scale[g];
+        if (a != 0.0) {
+          switch (r % 4) {
+            case 0: acc.col(cs) += a * sp; acc.col(cc) += a * cp; break;
+            case 1: acc.col(cs) -= a * cp; acc.col(cc) += a * sp; break;
+            case 2: acc.col(cs) -= a * sp; acc.col(cc) -= a * cp; break;
+            default: acc.col(cs) += a * cp; acc.col(cc) -= a * sp; break;
+          }
+        }
+        scale[g] = a * loads_[g].omega * eta_ / (r + 1);
+      }
+      us[ru + 1] = f * acc;
+    }
+    const auto last = static_cast<std::size_t>(d_ + 1);
+    ps[last] = touching.asDiagonal() * gw[last];
+
+    // bar = T v + Σ_g (sin_g, cos_g responses) + Σ_r correction_r p_r.
+    Matrix bar = Matrix::Zero(2 * n, cols);
+    bar.leftCols(2 * n) = Matrix(transition_);
+    for (std::size_t g = 0; g < harmonics_.size(); ++g) {
+      const Index cs = first_phase + 2 * static_cast<Index>(g);
+      bar.col(cs) += Vector(harmonics_[g].sin_response);
+      bar.col(cs + 1) += Vector(harmonics_[g].cos_response);
+    }
+    for (std::size_t r = 0; r < correction_.size(); ++r) bar += Matrix(correction_[r]) * ps[r];
+
+    auto out = std::make_unique<ModeOps>();
+    // The phase columns in the order of phases_: sin, cos (zero without a load), 1.
+    const auto phase_columns = [&](const Matrix& a) {
+      Matrix b = Matrix::Zero(a.rows(), 3);
+      b.leftCols(2 * groups) = a.middleCols(first_phase, 2 * groups);
+      b.col(2) = a.col(constant);
+      return b;
+    };
+    out->bar = bar.leftCols(2 * n);
+    out->bar_load = phase_columns(bar);
+    for (std::size_t r = 0; r < terms; ++r) {
+      out->gap.push_back(gw[r].leftCols(2 * n));
+      out->gap_load.push_back(phase_columns(gw[r]));
+    }
+    out->touching = touching;
+    out->slope_rows = eta_ * touching.asDiagonal() * W_t;
+
+    // The LCP transform of the mode as active set: x = T_A q with z_A = -M_AA⁻¹ q_A and
+    // w_F = q_F - M_FA M_AA⁻¹ q_A.
+    std::vector<Index> active;
+    for (Index j = 0; j < m; ++j)
+      if (mode_[j] > 0.0) active.push_back(j);
+    const auto k = static_cast<Index>(active.size());
+    const auto at = [&](Index a) { return active[static_cast<std::size_t>(a)]; };
+    Matrix block(k, k);
+    for (Index a = 0; a < k; ++a)
+      for (Index b = 0; b < k; ++b) block(a, b) = lcp_matrix_(at(a), at(b));
+    Matrix inverse = Matrix::Identity(k, k);
+    out->lcp_ready = true;
+    if (k > 0) {
+      const Eigen::FullPivLU<Matrix> lu(block);
+      if (lu.isInvertible()) {
+        inverse = lu.inverse();
+      } else {
+        out->lcp_ready = false;  // the solver reports it
+      }
+    }
+    Matrix transform = Matrix::Zero(m, m);
+    for (Index a = 0; a < k; ++a)
+      for (Index b = 0; b < k; ++b) transform(at(a), at(b)) = -inverse(a, b);
+    for (Index i = 0; i < m; ++i) {
+      if (mode_[i] > 0.0) continue;
+      transform(i, i) = 1.0;
+      for (Index b = 0; b < k; ++b) {
+        double sum = 0.0;
+        for (Index a = 0; a < k; ++a) sum += lcp_matrix_(i, at(a)) * inverse(a, b);
+        transform(i, at(b)) = -sum;
+      }
+    }
+    out->lcp_transform = transform;
+    return out;
+  }
+
+  // The per-mode cache needs fixed sizes (products unrolled, at most 2^6 modes).
+  static constexpr bool kModeCache = Dofs != Eigen::Dynamic && Springs != Eigen::Dynamic;
+  static constexpr Index kMaxCachedSprings = 6;
+  static constexpr long kReanchorSteps = 256;
+  static constexpr double kLcpFeasTol = 1e-11;  // as in lcp_solver.cpp: relative to |q|_inf
+
+  SwitchingPimOptions o_;
+  Index n_, m_;
+  int d_;
+  double eta_;
+  std::unique_ptr<LcpSolver> solver_;
+  StateSquare transition_;
+  std::vector<StateForce> correction_;  // coefficients of p_r (with the slope prediction)
+  StateForce phi_;                      // ... of P_{k+1}
+  StateForce slope_;                    // ... of η P'_{k+1}
+  bool end_derivative_ = false;
+  Force slope_guess_;
+  std::vector<Harmonic> harmonics_;
+  HalfSquare stiffness_part_, damping_part_;
+  HalfForce force_part_;
+  ForceHalf gap_rows_, spring_rows_, abs_gap_rows_;
+  Force gaps_, stiffnesses_, spring_offset_;
+  std::vector<Load> loads_;
+  double phase_sin_[16] = {}, phase_cos_[16] = {}, load_scale_[16] = {};
+
+  std::vector<Half> xs_, us_;
+  std::vector<Force> ps_, gw_;
+  Force mode_, signs_;
+  State state_, bar_;
+  Force z_, w_, q_;
+  double origin_ = 0.0;
+  long steps_ = 0;
+  double x_scale_ = 0.0;
+  Vector position_, velocity_;
+  IntegratorStats stats_;
+  SwitchingPimDiagnostics diagnostics_;
+  PolynomialGaps poly_;
+  event_detail::EventLocator locator_;
+  GapSample start_;
+  event_detail::SearchSettings settings_;
+  std::vector<Index> flip_;
+
+  Matrix lcp_matrix_;
+  double lcp_scale_ = 1.0;       // max |M_ij| of the LCP matrix
+  bool inline_lcp_ = false;      // the solver is block pivoting
+  bool mode_cached_ = false;     // step_cached() is used
+  std::uint64_t mode_mask_ = 0;  // bit j: spring j touching (mode_[j] = 1)
+  std::vector<std::unique_ptr<ModeOps>> mode_ops_;  // by mode_mask_
+  std::vector<Rotation> rotations_;
+  Phases phases_;  // sin ωt, cos ωt of the load group at the step start, and 1
+  Force lcp_x_;
+  Half scaled_velocity_;  // η x'
+};
+
+template <int N>
+std::unique_ptr<SwitchingPim> make_fixed(const Operators& ops, const SwitchingPimOptions& o) {
+  if constexpr (N > 0) {
+    if (ops.gap_rows.cols() == N && ops.gap_rows.rows() == N) {
+      return std::make_unique<Stepper<N, N>>(ops, o);
+    }
+    return make_fixed<N - 1>(ops, o);
+  } else {
+    return std::make_unique<Stepper<Eigen::Dynamic, Eigen::Dynamic>>(ops, o);
+  }
+}
+
+}  // namespace
+
+std::unique_ptr<SwitchingPim> make_switching_pim(const GapStructure& structure,
+                                                 const SwitchingPimOptions& options) {
+  std::string why;
+  if (!options.is_valid(&why)) throw InputError("switching pim options: " + why);
+  structure.validate();
+  if (structure.load_groups().size() > 16) {
+    throw InputError(fmt::format("loads: {} distinct frequencies; the switching PIM handles at "
+                                 "most 16",
+                                 structure.load_groups().size()));
+  }
+  const Operators ops = make_operators(structure, options);
+  return make_fixed<6>(ops, options);
+}
+
+}  // namespace pwl

@@ -1,0 +1,169 @@
+// The banded LCP solver against the dense solvers of lcp_solver.hpp (block pivoting and Lemke)
+// on banded P-matrices of both kinds it treats differently: diagonally dominant (Gauss-Seidel on
+// the active set) and not (band LU of the active set).
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <random>
+
+#include "pwl/numerics/banded_lcp_solver.hpp"
+#include "pwl/integrators/banded_step_operators.hpp"
+#include "pwl/model/chain_builders.hpp"
+#include "pwl/errors.hpp"
+
+using namespace pwl;
+
+namespace {
+
+Matrix random_band(Index n, Index b, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Matrix E = Matrix::Zero(n, n);
+  for (Index i = 0; i < n; ++i)
+    for (Index j = std::max<Index>(0, i - b); j <= std::min(n - 1, i + b); ++j) E(i, j) = u(rng);
+  return E;
+}
+
+// Strictly diagonally dominant with ratio `ratio`.
+Matrix dominant(Index n, Index b, double ratio, std::mt19937& rng) {
+  Matrix M = random_band(n, b, rng);
+  for (Index i = 0; i < n; ++i) {
+    M(i, i) = 0.0;
+    M(i, i) = M.row(i).cwiseAbs().sum() / ratio + 1e-3;
+  }
+  return M;
+}
+
+// Positive definite symmetric part (a P-matrix) without diagonal dominance: B^T B + 0.05 I plus a
+// skew-symmetric band.
+Matrix definite(Index n, Index b, std::mt19937& rng) {
+  const Matrix B = random_band(n, b, rng);
+  const Matrix K = random_band(n, b, rng);
+  return B.transpose() * B + 0.05 * Matrix::Identity(n, n) + 0.5 * (K - K.transpose());
+}
+
+Vector random_q(Index n, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Vector q(n);
+  for (Index i = 0; i < n; ++i) q[i] = u(rng);
+  return q;
+}
+
+struct Solved {
+  Vector z, w;
+};
+
+Solved solve(LcpSolver& s, const Vector& q, const Vector& warm) {
+  Solved r{warm, Vector::Zero(q.size())};
+  s.solve(q, r.z, r.w);
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("Banded LCP solutions equal the dense solvers' on banded P-matrices", "[banded][lcp]") {
+  std::mt19937 rng(42);
+  const Index n = 60;
+  for (int kind = 0; kind < 2; ++kind) {
+    for (Index b : {1, 3, 6}) {
+      const Matrix M = kind == 0 ? dominant(n, b, 0.4, rng) : definite(n, b, rng);
+      BandedLcpSolver banded;
+      banded.set_matrix(BandedMatrix::from_dense_nonzeros(M));
+      auto dense = make_block_pivoting_solver();
+      dense->set_matrix(M);
+      auto lemke = make_lemke_solver();
+      lemke->set_matrix(M);
+      INFO(std::string(kind == 0 ? "dominant" : "definite") << ", bandwidth " << b << ", dominance "
+                                                 << banded.dominance());
+      CHECK(banded.iterates() == (kind == 0));
+      CHECK(is_p_matrix(BandedMatrix::from_dense_nonzeros(M)));
+      for (int trial = 0; trial < 5; ++trial) {
+        const Vector q = random_q(n, rng);
+        const Solved a = solve(banded, q, Vector::Zero(n));
+        const Solved d = solve(*dense, q, Vector::Zero(n));
+        const Solved l = solve(*lemke, q, Vector::Zero(n));
+        CHECK(lcp_residual(M, q, a.z, a.w) <= 1e-12);
+        CHECK((a.z - d.z).cwiseAbs().maxCoeff() <= 1e-11 * (1 + d.z.cwiseAbs().maxCoeff()));
+        CHECK((a.z - l.z).cwiseAbs().maxCoeff() <= 1e-10 * (1 + l.z.cwiseAbs().maxCoeff()));
+        CHECK(a.z.minCoeff() >= 0.0);
+        CHECK(a.w.minCoeff() >= 0.0);
+      }
+      if (kind == 0) {
+        CHECK(banded.sweeps() > 0);
+        CHECK(banded.factorized_rows() == 0);
+      } else {
+        CHECK(banded.factorized_rows() > 0);
+      }
+    }
+  }
+}
+
+TEST_CASE("Warm starts from the previous solution take few pivots", "[banded][lcp]") {
+  std::mt19937 rng(7);
+  const Index n = 80;
+  for (int kind = 0; kind < 2; ++kind) {
+    const Matrix M = kind == 0 ? dominant(n, 4, 0.2, rng) : definite(n, 3, rng);
+    BandedLcpSolver banded;
+    banded.set_matrix(M);  // the dense interface keeps the band of the non-zeros
+    auto dense = make_block_pivoting_solver();
+    dense->set_matrix(M);
+    // A second solver on the stepper's path: in place, from its own last active set.
+    BandedLcpSolver stepper;
+    stepper.set_matrix(M);
+    const Vector q0 = random_q(n, rng), dq = random_q(n, rng);
+    Vector z = Vector::Zero(n), w = Vector::Zero(n), zs = Vector::Zero(n);
+    stepper.reset_active_set(zs);
+    long warm_pivots = 0, cold_pivots = 0, stepper_pivots = 0;
+    for (int k = 0; k < 40; ++k) {
+      const Vector q = q0 + 0.02 * k * dq;
+      warm_pivots += banded.solve(q, z, w).pivots;  // z holds the previous solution
+      Vector zc = Vector::Zero(n), wc(n);
+      cold_pivots += banded.solve(q, zc, wc).pivots;
+      stepper_pivots += stepper.solve_forces(q, zs).pivots;
+      const Solved d = solve(*dense, q, Vector::Zero(n));
+      INFO("kind " << kind << ", k " << k);
+      CHECK((z - d.z).cwiseAbs().maxCoeff() <= 1e-11 * (1 + d.z.cwiseAbs().maxCoeff()));
+      CHECK((zc - d.z).cwiseAbs().maxCoeff() <= 1e-11 * (1 + d.z.cwiseAbs().maxCoeff()));
+      CHECK((zs - d.z).cwiseAbs().maxCoeff() <= 1e-11 * (1 + d.z.cwiseAbs().maxCoeff()));
+      std::vector<int> positive;
+      for (Index i = 0; i < n; ++i)
+        if (zs[i] > 0.0) positive.push_back(static_cast<int>(i));
+      for (int i : positive) CHECK(std::find(stepper.active_set().begin(), stepper.active_set().end(), i) != stepper.active_set().end());
+    }
+    CHECK(warm_pivots * 4 < cold_pivots);
+    CHECK(stepper_pivots == warm_pivots);
+  }
+}
+
+TEST_CASE("The step's LCP matrix is dominant; bad matrices and input are reported",
+          "[banded][lcp]") {
+  const BandedStepOperators ops =
+      make_banded_step_operators(make_chain(paper_large_chain(100)), 0.02);
+  BandedLcpSolver s;
+  s.set_matrix(ops.lcp_matrix);
+  CHECK(s.iterates());
+  CHECK(s.dominance() < 1e-3);
+  CHECK(is_p_matrix(ops.lcp_matrix));
+
+  // Zero diagonal: no P-matrix; the active set {0, 1} is singular.
+  Matrix M(2, 2);
+  M << 0.0, 1.0, 1.0, 0.0;
+  BandedLcpSolver bad;
+  bad.set_matrix(M);
+  CHECK_FALSE(bad.iterates());
+  std::string why;
+  CHECK_FALSE(is_p_matrix(BandedMatrix::from_dense_nonzeros(M), &why));
+  CHECK(!why.empty());
+  Vector z = Vector::Zero(2), w = Vector::Zero(2);
+  CHECK_THROWS_AS(bad.solve(Vector::Constant(2, -1.0), z, w), LcpError);
+
+  BandedLcpSolver fresh;
+  CHECK_THROWS_AS(fresh.solve(Vector::Ones(2), z, w), InputError);
+  CHECK_THROWS_AS(fresh.set_matrix(Matrix::Ones(2, 3)), InputError);
+  fresh.set_matrix(Matrix::Identity(2, 2));
+  Vector nan_q(2);
+  nan_q << 1.0, std::nan("");
+  CHECK_THROWS_WITH(fresh.solve(nan_q, z, w), Catch::Contains("q[1]"));
+  BandedLcpOptions o;
+  o.dominance_limit = 1.5;
+  CHECK_THROWS_WITH(BandedLcpSolver(o), Catch::Contains("dominance_limit = 1.5"));
+}

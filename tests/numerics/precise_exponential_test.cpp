@@ -1,0 +1,129 @@
+// The 2^N algorithm and its inverse-free load integrals against Eigen's matrix exponential
+// (scaling and squaring with Padé approximants: an independent algorithm) of Van Loan's
+// block-triangular matrices, which contain the same integrals as blocks.
+#include <catch2/catch.hpp>
+#include <unsupported/Eigen/MatrixFunctions>
+
+#include <cmath>
+#include <random>
+
+#include "pwl/errors.hpp"
+#include "pwl/numerics/precise_exponential.hpp"
+
+using namespace pwl;
+
+namespace {
+
+Matrix random_state_matrix(int n, unsigned seed, double damping) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal;
+  Matrix A(n, n);
+  for (Index i = 0; i < A.size(); ++i) A.data()[i] = normal(rng);
+  const Matrix K = A * A.transpose() + 0.1 * Matrix::Identity(n, n);
+  Matrix H = Matrix::Zero(2 * n, 2 * n);
+  H.topRightCorner(n, n).setIdentity();
+  H.bottomLeftCorner(n, n) = -K;
+  H.bottomRightCorner(n, n) = -damping * K;
+  return H;
+}
+
+double relative_error(const Matrix& a, const Matrix& b) {
+  return (a - b).norm() / std::max(1e-300, b.norm());
+}
+
+}  // namespace
+
+TEST_CASE("2^N exponential matches Eigen's Pade exponential", "[precise_exponential]") {
+  for (int n : {1, 3, 6}) {
+    for (double eta : {0.01, 0.3, 2.0}) {
+      const Matrix H = random_state_matrix(n, 7u + static_cast<unsigned>(n), 0.05);
+      const Matrix T = precise_exponential(H, eta);
+      const Matrix expected = (H * eta).exp();
+      INFO("n = " << n << ", eta = " << eta);
+      CHECK(relative_error(T, expected) < 1e-12);
+    }
+  }
+}
+
+TEST_CASE("Gamma0 and Gamma1 match Van Loan's block exponential", "[precise_exponential]") {
+  // exp([[H, G, 0], [0, 0, I], [0, 0, 0]] η) has top blocks ∫ e^{Hu} du G and ∫ e^{H(η-s)} s ds G;
+  // Γ1 = ∫ e^{Hu} u du = η Γ0 - ∫ e^{H(η-s)} s ds.
+  const int n = 4, m = 3;
+  const Matrix H = random_state_matrix(n, 11u, 0.1);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> normal;
+  Matrix G(2 * n, m);
+  for (Index i = 0; i < G.size(); ++i) G.data()[i] = normal(rng);
+  for (double eta : {0.05, 0.7}) {
+    Matrix A = Matrix::Zero(2 * n + 2 * m, 2 * n + 2 * m);
+    A.topLeftCorner(2 * n, 2 * n) = H;
+    A.block(0, 2 * n, 2 * n, m) = G;
+    A.block(2 * n, 2 * n + m, m, m).setIdentity();
+    const Matrix E = (A * eta).exp();
+    const Matrix gamma0 = E.block(0, 2 * n, 2 * n, m);
+    const Matrix moment = E.block(0, 2 * n + m, 2 * n, m);
+    const PreciseExponential p = precise_exponential(H, eta, G, Matrix(2 * n, 0), Vector(0));
+    INFO("eta = " << eta);
+    CHECK(relative_error(p.gamma0, gamma0) < 1e-12);
+    CHECK(relative_error(p.gamma1, eta * gamma0 - moment) < 1e-11);
+  }
+}
+
+TEST_CASE("Harmonic load integrals match Van Loan's block exponential", "[precise_exponential]") {
+  // exp([[H, b, 0], [0, 0, -ω], [0, ω, 0]] η): the column fed by w(0) = (1, 0) is
+  // ∫ e^{H(η-s)} b cos ωs ds = Re K b, the one fed by (0, 1) is -∫ e^{H(η-s)} b sin ωs ds = -Im K b.
+  const int n = 3;
+  for (double damping : {0.0, 0.2}) {
+    const Matrix H = random_state_matrix(n, 3u, damping);
+    Vector b = Vector::Zero(2 * n);
+    b.tail(n) << 1.0, -2.0, 0.5;
+    for (double omega : {0.0, 0.8, 3.0}) {
+      const double eta = 0.4;
+      Matrix A = Matrix::Zero(2 * n + 2, 2 * n + 2);
+      A.topLeftCorner(2 * n, 2 * n) = H;
+      A.block(0, 2 * n, 2 * n, 1) = b;
+      A(2 * n, 2 * n + 1) = -omega;
+      A(2 * n + 1, 2 * n) = omega;
+      const Matrix E = (A * eta).exp();
+      Vector w(1);
+      w << omega;
+      const PreciseExponential p = precise_exponential(H, eta, Matrix(2 * n, 0), b, w);
+      INFO("omega = " << omega << ", damping = " << damping);
+      CHECK(relative_error(p.harmonic_real, E.block(0, 2 * n, 2 * n, 1)) < 1e-12);
+      if (omega > 0.0) {
+        CHECK(relative_error(p.harmonic_imag, -E.block(0, 2 * n + 1, 2 * n, 1)) < 1e-12);
+      } else {
+        CHECK(p.harmonic_imag.norm() < 1e-14);
+      }
+    }
+  }
+}
+
+TEST_CASE("Singular H: the integrals need no inverse", "[precise_exponential]") {
+  // A free mass: H = [[0, 1], [0, 0]]. Γ0 G with G = [0; 1] is [η²/2; η].
+  Matrix H(2, 2);
+  H << 0, 1, 0, 0;
+  Matrix G(2, 1);
+  G << 0, 1;
+  const double eta = 0.37;
+  const PreciseExponential p = precise_exponential(H, eta, G, Matrix(2, 0), Vector(0));
+  CHECK(p.transition(0, 1) == Approx(eta).epsilon(1e-15));
+  CHECK(p.gamma0(0, 0) == Approx(eta * eta / 2).epsilon(1e-14));
+  CHECK(p.gamma0(1, 0) == Approx(eta).epsilon(1e-14));
+  // Γ1 G = ∫ [u²/2... ]: ∫_0^η [u; 1] u du = [η³/3; η²/2].
+  CHECK(p.gamma1(0, 0) == Approx(eta * eta * eta / 3).epsilon(1e-14));
+  CHECK(p.gamma1(1, 0) == Approx(eta * eta / 2).epsilon(1e-14));
+}
+
+TEST_CASE("Bad input to the exponential is named", "[precise_exponential]") {
+  const Matrix H = Matrix::Identity(2, 2);
+  CHECK_THROWS_WITH(precise_exponential(H, 0.0), Catch::Contains("step = 0"));
+  CHECK_THROWS_WITH(precise_exponential(H, -1.0), Catch::Contains("step = -1"));
+  CHECK_THROWS_AS(precise_exponential(Matrix(2, 3), 1.0), InputError);
+  Matrix bad = H;
+  bad(0, 1) = std::nan("");
+  CHECK_THROWS_WITH(precise_exponential(bad, 1.0), Catch::Contains("H has a non-finite"));
+  PreciseExponentialOptions options;
+  options.doublings = -1;
+  CHECK_THROWS_WITH(precise_exponential(H, 1.0, options), Catch::Contains("doublings = -1"));
+}
