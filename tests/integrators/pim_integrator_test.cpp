@@ -26,7 +26,7 @@ GapStructure single_mass(double m, double c, double k) {
 PimOptions pim(double step, const std::string& solver = "block-pivoting") {
   PimOptions o;
   o.step = step;
-  o.lcp_solver = solver;
+  o.lcp_solver = parse_lcp_algorithm(solver);
   return o;
 }
 

@@ -6,13 +6,8 @@
 #include <cmath>
 
 #include "commands/cli_checks.hpp"
-#include "pwl/integrators/banded_pim_integrator.hpp"
-#include "pwl/integrators/banded_switching_pim.hpp"
 #include "pwl/errors.hpp"
-#include "pwl/integrators/event_driven_solver.hpp"
-#include "pwl/integrators/pim_integrator.hpp"
-#include "pwl/integrators/reference_integrator.hpp"
-#include "pwl/integrators/switching_pim.hpp"
+#include "pwl/integrators/method_table.hpp"
 #include "scene/scene_structure.hpp"
 
 namespace pwl::app {
@@ -37,6 +32,14 @@ void add_chain_options(CLI::App& c, std::string& figure, int& masses, std::vecto
       ->default_str(fmt::format("{} or --figure's", fmt::join(d.amplitude, ",")));
 }
 
+std::string method_help() {
+  std::string help = "Integrator:";
+  for (const MethodTraits& row : method_table()) {
+    help += fmt::format("\n  {}: {}", row.name, row.summary);
+  }
+  return help;
+}
+
 void add_case_options(CLI::App& c, CaseOptions& o) {
   add_chain_options(c, o.figure, o.masses, o.alpha, o.zeta, o.gap, o.theta, o.loads);
   c.add_option("--gaps", o.gaps, "Gaps per mass, comma separated (overrides --gap)")
@@ -48,12 +51,7 @@ void add_case_options(CLI::App& c, CaseOptions& o) {
   c.add_option("--steps-per-period", o.steps_per_period, "PIM steps per forcing period")
       ->check(positive_number());
   c.add_option("--dt", o.dt, "PIM step (must divide the forcing period)");
-  c.add_option("--method", o.method,
-               "Integrator: pim (dense or banded by size), pim-dense, pim-banded, pim-switching\n"
-               "(higher order, located switches; dense or banded by size), pim-switching-banded,\n"
-               "exact (event-driven), dopri5 or rkf78")
-      ->check(CLI::IsMember({"pim", "pim-dense", "pim-banded", "pim-switching",
-                             "pim-switching-banded", "exact", "dopri5", "rkf78"}));
+  c.add_option("--method", o.method, method_help())->check(CLI::IsMember(method_names()));
   c.add_option("--tol", o.tolerance, "Relative and absolute tolerance of dopri5/rkf78");
   c.add_flag("--locate-kinks", o.locate_kinks,
              "dopri5/rkf78: end a step exactly at every spring opening or closing");
@@ -124,43 +122,20 @@ double CaseOptions::step(double period) const {
   return period / std::round(ratio);
 }
 
+MethodSettings CaseOptions::method_settings(double period) const {
+  MethodSettings m;
+  m.method = parse_method(method);
+  if (method_traits(m.method).fixed_grid) m.step = step(period);
+  m.tolerance = tolerance;
+  m.locate_kinks = locate_kinks;
+  m.max_step = period / 8;
+  m.lcp = parse_lcp_algorithm(lcp_solver);
+  return m;
+}
+
 std::unique_ptr<Integrator> CaseOptions::integrator(const GapStructure& structure,
                                                     double period) const {
-  std::unique_ptr<Integrator> result;
-  if (method == "pim" || method == "pim-dense") {
-    PimOptions p;
-    p.step = step(period);
-    p.lcp_solver = lcp_solver;
-    result = method == "pim" ? make_pim_integrator_auto(structure, p)
-                             : make_pim_integrator(structure, p);
-  } else if (method == "pim-banded") {
-    BandedPimOptions b;
-    b.step = step(period);
-    result = make_banded_pim_integrator(structure, b);
-  } else if (method == "pim-switching" || method == "pim-switching-banded") {
-    SwitchingPimOptions s;
-    s.step = step(period);
-    s.lcp_solver = lcp_solver;
-    if (method == "pim-switching-banded" ||
-        (banded_layout(structure).banded && structure.dofs() > 50)) {
-      BandedSwitchingPimOptions b;
-      b.pim = s;
-      result = make_banded_switching_pim(structure, b);
-    } else {
-      result = make_switching_pim(structure, s);
-    }
-  } else if (method == "exact") {
-    result = make_event_driven_solver(structure);
-  } else {
-    ReferenceOptions r;
-    r.method = parse_runge_kutta_method(method);
-    r.relative_tolerance = r.absolute_tolerance = tolerance;
-    r.locate_kinks = locate_kinks;
-    r.max_step = period / 8;
-    result = make_reference_integrator(structure, r);
-  }
-  result->set_state(0.0, Vector::Zero(structure.dofs()), Vector::Zero(structure.dofs()));
-  return result;
+  return make_integrator(structure, method_settings(period));
 }
 
 }  // namespace pwl::app

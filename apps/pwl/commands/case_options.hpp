@@ -9,6 +9,7 @@
 
 #include "pwl/model/chain_builders.hpp"
 #include "pwl/integrators/integrator.hpp"
+#include "pwl/integrators/method_table.hpp"
 
 namespace pwl::app {
 
@@ -45,11 +46,16 @@ struct CaseOptions {
   std::string description() const;
   // The step the PIM uses: period / steps_per_period, or dt when it divides the period.
   double step(double period) const;
+  // The method table's settings these flags give (the step only for fixed-grid methods).
+  MethodSettings method_settings(double period) const;
   // The integrator the flags name, with its state at rest at t = 0.
   std::unique_ptr<Integrator> integrator(const GapStructure& structure, double period) const;
 };
 
 void add_case_options(CLI::App& command, CaseOptions& options);
+
+// --method's help: one line per row of the method table.
+std::string method_help();
 
 // The chain's own flags (--figure, --n, --alpha, --zeta, --gap, --theta, --loads), shared with
 // the sweep and map jobs.

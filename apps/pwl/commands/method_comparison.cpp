@@ -36,17 +36,6 @@ int count_distinct_points(const std::vector<std::pair<double, double>>& points, 
   return static_cast<int>(centres.size());
 }
 
-namespace {
-
-std::string method_label(const std::string& method, double tolerance, bool locate_kinks) {
-  if (method == "pim" || method == "pim-dense" || method == "pim-banded") return "PIM";
-  if (method.rfind("pim-switching", 0) == 0) return "switching PIM";
-  if (method == "exact") return "exact event-driven";
-  return fmt::format("{}{}, tol {:g}", method, locate_kinks ? ", kink-located" : "", tolerance);
-}
-
-}  // namespace
-
 ComparisonResult simulate_with_comparison(const CaseOptions& run, const ComparisonOptions& with,
                                           const RecordingOptions& output) {
   const std::vector<int>& record = output.record;
@@ -120,8 +109,8 @@ ComparisonResult simulate_with_comparison(const CaseOptions& run, const Comparis
   result.reference_distinct_points = count_distinct_points(points_b, 1e-4);
   result.cloud_size = cloud_diameter(points_a);
 
-  const std::string label_a = method_label(run.method, run.tolerance, run.locate_kinks);
-  const std::string label_b = method_label(other.method, other.tolerance, other.locate_kinks);
+  const std::string label_a = method_label(run.method_settings(period));
+  const std::string label_b = method_label(other.method_settings(period));
   if (!output.quiet) {
     fmt::print("{} against {}, on a grid of T/{}:\n", label_a, label_b, steps);
     fmt::print("largest difference (every x and x', every step): {:.2e}\n",

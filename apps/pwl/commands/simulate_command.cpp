@@ -120,8 +120,7 @@ void add_simulate_command(CLI::App& app) {
   c->add_option("--title", output.title, "Title of the figure");
   c->add_option("--compare-with", options->compare.method,
                 "Integrate the case again by this method, on the same time grid, and compare")
-      ->check(CLI::IsMember({"pim", "pim-dense", "pim-banded", "pim-switching",
-                             "pim-switching-banded", "exact", "dopri5", "rkf78"}));
+      ->check(CLI::IsMember(method_names()));
   c->add_option("--compare-tol", options->compare.tolerance,
                 "Tolerance of the compared method (dopri5/rkf78)")
       ->check(positive_number());

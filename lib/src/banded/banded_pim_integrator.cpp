@@ -77,6 +77,7 @@ class BandedPimIntegrator final : public Integrator {
     velocity_ = position_;
   }
 
+  Method method() const override { return Method::pim_banded; }
   std::string name() const override {
     return fmt::format("pim-banded (step {:.6g}, band {})", propagator_.step_size(),
                        propagator_.operators().truncation.band);

@@ -1,6 +1,7 @@
 #include "pwl/integrators/integrator.hpp"
 
 #include "pwl/errors.hpp"
+#include "pwl/integrators/method_table.hpp"
 
 namespace pwl {
 
@@ -8,5 +9,7 @@ void Integrator::advance_with_tangent(double, Matrix&, const StepObserver&) {
   throw InputError(name() + " has no exact tangent map; estimate Lyapunov exponents from two "
                             "nearby trajectories instead");
 }
+
+bool Integrator::has_tangent_map() const { return method_traits(method()).tangent_map; }
 
 }  // namespace pwl

@@ -182,6 +182,7 @@ RhsInfo validate_solve(const char* who, bool has_matrix, Index n,
 class LemkeSolver final : public LcpSolver {
  public:
   std::string name() const override { return "lemke"; }
+  LcpAlgorithm algorithm() const override { return LcpAlgorithm::lemke; }
 
   void set_matrix(const Matrix& M) override {
     const double mmax = validate_matrix(M, "Lemke");
@@ -361,6 +362,7 @@ class LemkeSolver final : public LcpSolver {
 class BlockPivotingSolver final : public LcpSolver {
  public:
   std::string name() const override { return "block-pivoting"; }
+  LcpAlgorithm algorithm() const override { return LcpAlgorithm::block_pivoting; }
 
   void set_matrix(const Matrix& M) override {
     const double mmax = validate_matrix(M, "block pivoting");
@@ -634,11 +636,23 @@ std::unique_ptr<LcpSolver> make_block_pivoting_solver() {
   return std::make_unique<BlockPivotingSolver>();
 }
 
-std::unique_ptr<LcpSolver> make_lcp_solver(const std::string& name) {
-  if (name == "lemke") return make_lemke_solver();
-  if (name == "block-pivoting") return make_block_pivoting_solver();
+std::string lcp_algorithm_name(LcpAlgorithm algorithm) {
+  return algorithm == LcpAlgorithm::lemke ? "lemke" : "block-pivoting";
+}
+
+LcpAlgorithm parse_lcp_algorithm(const std::string& name) {
+  if (name == "lemke") return LcpAlgorithm::lemke;
+  if (name == "block-pivoting") return LcpAlgorithm::block_pivoting;
   throw InputError(fmt::format(
       "LCP solver name '{}' is not known; accepted names are 'lemke' and 'block-pivoting'", name));
+}
+
+std::unique_ptr<LcpSolver> make_lcp_solver(LcpAlgorithm algorithm) {
+  return algorithm == LcpAlgorithm::lemke ? make_lemke_solver() : make_block_pivoting_solver();
+}
+
+std::unique_ptr<LcpSolver> make_lcp_solver(const std::string& name) {
+  return make_lcp_solver(parse_lcp_algorithm(name));
 }
 
 bool is_p_matrix(const Matrix& M, std::string* why) {

@@ -17,10 +17,6 @@ bool PimOptions::is_valid(std::string* why) const {
     *why = fmt::format("step = {} must be positive and finite", step);
     return false;
   }
-  if (lcp_solver != "block-pivoting" && lcp_solver != "lemke") {
-    *why = fmt::format("lcp_solver = \"{}\" must be \"block-pivoting\" or \"lemke\"", lcp_solver);
-    return false;
-  }
   if (!(divergence_bound > 0.0)) {
     *why = fmt::format("divergence_bound = {} must be positive", divergence_bound);
     return false;
@@ -35,7 +31,7 @@ class PimIntegrator final : public Integrator {
  public:
   PimIntegrator(const PimStepOperators& ops, const PimOptions& options)
       : propagator_(ops, make_lcp_solver(options.lcp_solver), options.divergence_bound),
-        solver_name_(options.lcp_solver) {
+        solver_name_(lcp_algorithm_name(options.lcp_solver)) {
     position_ = Vector::Zero(propagator_.dofs());
     velocity_ = position_;
   }
@@ -57,7 +53,7 @@ class PimIntegrator final : public Integrator {
     advance(t_end, nullptr, observer);
   }
 
-  bool has_tangent_map() const override { return true; }
+  Method method() const override { return Method::pim_dense; }
   void advance_with_tangent(double t_end, Matrix& tangent, const StepObserver& observer) override {
     advance(t_end, &tangent, observer);
   }

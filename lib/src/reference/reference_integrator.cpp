@@ -87,14 +87,14 @@ struct SystemRef {
 };
 
 template <class Stepper>
-struct MethodTraits;
+struct RungeKuttaTraits;
 template <>
-struct MethodTraits<Dopri5> {
+struct RungeKuttaTraits<Dopri5> {
   static constexpr const char* name = "dopri5";
   static constexpr bool first_same_as_last = true;  // and has a continuous extension
 };
 template <>
-struct MethodTraits<Fehlberg78> {
+struct RungeKuttaTraits<Fehlberg78> {
   static constexpr const char* name = "rkf78";
   static constexpr bool first_same_as_last = false;
 };
@@ -122,7 +122,7 @@ int sign_of(double value) { return value > 0.0 ? 1 : (value < 0.0 ? -1 : 0); }
 template <class Stepper>
 class RungeKuttaIntegrator final : public Integrator {
   using Controlled = odeint::controlled_runge_kutta<Stepper, ErrorChecker, StepAdjuster>;
-  static constexpr bool kFsal = MethodTraits<Stepper>::first_same_as_last;
+  static constexpr bool kFsal = RungeKuttaTraits<Stepper>::first_same_as_last;
   enum class Outcome { none, event, redo };
   // Interior points per step at which the gap functions are sampled for a pair of crossings
   // (a brief contact) inside one step. dopri5's samples are continuous-extension states (O(n)
@@ -155,8 +155,11 @@ class RungeKuttaIntegrator final : public Integrator {
   RungeKuttaIntegrator(const RungeKuttaIntegrator&) = delete;
   RungeKuttaIntegrator& operator=(const RungeKuttaIntegrator&) = delete;
 
+  Method method() const override {
+    return options_.method == RungeKuttaMethod::dopri5 ? Method::dopri5 : Method::rkf78;
+  }
   std::string name() const override {
-    return fmt::format("{}{} (rtol {:g})", MethodTraits<Stepper>::name,
+    return fmt::format("{}{} (rtol {:g})", RungeKuttaTraits<Stepper>::name,
                        options_.locate_kinks ? " kink-located" : "", options_.relative_tolerance);
   }
 

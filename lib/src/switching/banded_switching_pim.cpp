@@ -291,6 +291,7 @@ class BandedStepper final : public SwitchingPim {
     velocity_ = position_;
   }
 
+  Method method() const override { return Method::pim_switching_banded; }
   std::string name() const override {
     return fmt::format("pim-switching-banded (order {}{}, step {:.6g}, band {})",
                        d_ + (end_derivative_ ? 3 : 2),

@@ -31,10 +31,6 @@ bool SwitchingPimOptions::is_valid(std::string* why) const {
     *why = fmt::format("force_degree = {} must be in 0..8", force_degree);
     return false;
   }
-  if (lcp_solver != "block-pivoting" && lcp_solver != "lemke") {
-    *why = fmt::format("lcp_solver = \"{}\" must be \"block-pivoting\" or \"lemke\"", lcp_solver);
-    return false;
-  }
   if (!(divergence_bound > 0.0)) {
     *why = fmt::format("divergence_bound = {} must be positive", divergence_bound);
     return false;
@@ -277,7 +273,7 @@ class Stepper final : public SwitchingPim {
     lcp_matrix_ = ops.lcp_matrix;
     const double mmax = m_ > 0 ? lcp_matrix_.cwiseAbs().maxCoeff() : 0.0;
     lcp_scale_ = mmax > 0.0 ? mmax : 1.0;
-    inline_lcp_ = o.lcp_solver == "block-pivoting";
+    inline_lcp_ = o.lcp_solver == LcpAlgorithm::block_pivoting;
     // The per-mode operators take at most one load group (its harmonic response and load in
     // the same group); more frequencies take the Taylor recursion in every step.
     mode_cached_ = kModeCache && loads_.size() <= 1 && harmonics_.size() == loads_.size() &&
@@ -306,6 +302,7 @@ class Stepper final : public SwitchingPim {
     anchor_phases();
   }
 
+  Method method() const override { return Method::pim_switching_dense; }
   std::string name() const override {
     return fmt::format("pim-{} (order {}{}, step {:.6g})", o_.locate_switches ? "switching" : "hermite",
                        d_ + (end_derivative_ ? 3 : 2), o_.locate_switches ? ", located switches" : "",

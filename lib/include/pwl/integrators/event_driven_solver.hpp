@@ -94,6 +94,7 @@ class EventDrivenSolver final : public Integrator {
   EventDrivenSolver& operator=(const EventDrivenSolver&) = delete;
 
   std::string name() const override;
+  Method method() const override { return Method::exact; }
   Index dofs() const override;
   void set_state(double t, const Vector& x, const Vector& v) override;
   double time() const override;

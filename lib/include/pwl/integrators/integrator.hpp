@@ -8,6 +8,7 @@
 #include <memory>
 #include <string>
 
+#include "pwl/integrators/method.hpp"
 #include "pwl/types.hpp"
 
 namespace pwl {
@@ -27,7 +28,12 @@ struct IntegratorStats {
 class Integrator {
  public:
   virtual ~Integrator() = default;
+  // A description for messages and tables, with the integrator's settings ("pim (step 0.0314,
+  // block-pivoting)"). For people only: code asks method() and its row of the method table.
   virtual std::string name() const = 0;
+  // Which method of the method table this is (for a method that chooses its dense or banded form,
+  // the form it took).
+  virtual Method method() const = 0;
   virtual Index dofs() const = 0;
   // Sets time, displacements and velocities (the spring forces follow from x).
   virtual void set_state(double t, const Vector& x, const Vector& v) = 0;
@@ -46,8 +52,9 @@ class Integrator {
   // is that.
   virtual void advance_with_tangent(double t_end, Matrix& tangent,
                                     const StepObserver& observer = nullptr);
-  // Whether advance_with_tangent is implemented (false: it throws).
-  virtual bool has_tangent_map() const { return false; }
+  // Whether advance_with_tangent is implemented (false: it throws): the tangent_map column of this
+  // method's row of the method table.
+  bool has_tangent_map() const;
 };
 
 }  // namespace pwl

@@ -6,13 +6,14 @@
 
 #include "pwl/model/gap_structure.hpp"
 #include "pwl/integrators/integrator.hpp"
+#include "pwl/numerics/lcp_solver.hpp"
 #include "pwl/numerics/precise_exponential.hpp"
 
 namespace pwl {
 
 struct PimOptions {
   double step = 0.0;                         // η > 0
-  std::string lcp_solver = "block-pivoting"; // or "lemke"
+  LcpAlgorithm lcp_solver = LcpAlgorithm::block_pivoting;
   PreciseExponentialOptions exponential;     // N and the Taylor order
   double divergence_bound = 1e12;            // |x|, |x'| beyond this is a DivergenceError
   bool is_valid(std::string* why) const;

@@ -67,7 +67,7 @@ class PrecisePropagator {
     solver_->set_matrix(ops.lcp_matrix);
     lcp_matrix_ = ops.lcp_matrix;
     if constexpr (kInlineLcp) {
-      inline_lcp_ = solver_->name() == "block-pivoting";
+      inline_lcp_ = solver_->algorithm() == LcpAlgorithm::block_pivoting;
       const double mmax = m > 0 ? lcp_matrix_.cwiseAbs().maxCoeff() : 0.0;
       lcp_scale_ = mmax > 0.0 ? mmax : 1.0;
       transforms_.resize(std::size_t{1} << Springs);

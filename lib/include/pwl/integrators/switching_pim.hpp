@@ -81,6 +81,7 @@
 
 #include "pwl/model/gap_structure.hpp"
 #include "pwl/integrators/integrator.hpp"
+#include "pwl/numerics/lcp_solver.hpp"
 #include "pwl/numerics/precise_exponential.hpp"
 
 namespace pwl {
@@ -105,7 +106,7 @@ struct SwitchingPimOptions {
   // Also match the slope of P at the step end, predicted from the start's Taylor data and
   // corrected once from the new state: one more order (d + 3) for two thin products.
   bool end_derivative = true;
-  std::string lcp_solver = "block-pivoting";  // or "lemke"
+  LcpAlgorithm lcp_solver = LcpAlgorithm::block_pivoting;
   PreciseExponentialOptions exponential;
   double divergence_bound = 1e12;
   // Largest η ω_max allowed (ω_max: the largest |eigenvalue| of H with every spring touching).

@@ -46,6 +46,7 @@ class BandedLcpSolver final : public LcpSolver {
   explicit BandedLcpSolver(const BandedLcpOptions& options = {});
 
   std::string name() const override { return "banded block-pivoting"; }
+  LcpAlgorithm algorithm() const override { return LcpAlgorithm::block_pivoting; }
   // The dense interface: keeps the band of M's non-zeros.
   void set_matrix(const Matrix& M) override;
   void set_matrix(const BandedMatrix& M);

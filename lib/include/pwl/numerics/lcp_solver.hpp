@@ -20,6 +20,18 @@
 
 namespace pwl {
 
+// The LCP algorithms pwl ships. Names ("block-pivoting", "lemke") are for the command line and
+// scene files only (lcp_algorithm_name, parse_lcp_algorithm).
+enum class LcpAlgorithm {
+  block_pivoting,  // Júdice & Pires 1994, warm-started; the default
+  lemke,           // Lemke 1965, the paper's choice
+};
+
+// "block-pivoting" or "lemke".
+std::string lcp_algorithm_name(LcpAlgorithm algorithm);
+// The inverse. Throws InputError naming the value and the accepted names otherwise.
+LcpAlgorithm parse_lcp_algorithm(const std::string& name);
+
 struct LcpResult {
   int pivots = 0;  // principal pivots (block pivoting) or complementary pivots (Lemke)
 };
@@ -28,6 +40,7 @@ class LcpSolver {
  public:
   virtual ~LcpSolver() = default;
   virtual std::string name() const = 0;
+  virtual LcpAlgorithm algorithm() const = 0;
   // Tell the solver the matrix M (square, finite). It may factorise or cache here.
   virtual void set_matrix(const Matrix& M) = 0;
   // Solve for q. On entry z holds a warm start (its positive entries are the guessed active
@@ -48,6 +61,8 @@ std::unique_ptr<LcpSolver> make_lemke_solver();
 // so a step whose active set was seen before costs one small matrix-vector product.
 std::unique_ptr<LcpSolver> make_block_pivoting_solver();
 
+// Either algorithm.
+std::unique_ptr<LcpSolver> make_lcp_solver(LcpAlgorithm algorithm);
 // Both by name: "lemke" or "block-pivoting". Throws InputError for anything else.
 std::unique_ptr<LcpSolver> make_lcp_solver(const std::string& name);
 

@@ -1,0 +1,81 @@
+#pragma once
+// The method table: one row per integrator pwl ships, and the one factory that builds any of them.
+//
+// A row says what a method is called (on the command line and in tables), what it can do and what
+// it needs: a fixed step grid, an exact tangent map (Lyapunov exponents, Floquet multipliers),
+// banded operators, an error tolerance, kink location, a size limit, its order of accuracy. The
+// command line's choices, the labels of tables and figures, the checks of a study's settings and
+// the factory all read this table, so adding an integrator is one row here, one file that
+// implements it and one test. Code that needs a capability asks the row (`method_traits(m)`)
+// or the integrator (`Integrator::method()`), never a name.
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "pwl/integrators/integrator.hpp"
+#include "pwl/integrators/method.hpp"
+#include "pwl/model/gap_structure.hpp"
+#include "pwl/numerics/lcp_solver.hpp"
+
+namespace pwl {
+
+struct MethodTraits {
+  Method method;
+  std::string_view name;     // the command line's and the scene files' spelling: "pim-switching"
+  std::string_view label;    // for tables and figures: "switching PIM"
+  std::string_view summary;  // one line for --help
+  // What the method can do.
+  bool fixed_grid;    // steps of a fixed size η: needs a step, ends only on its grid
+  bool tangent_map;   // exact tangent map of the motion (advance_with_tangent)
+  bool adaptive;      // error-controlled step: takes a tolerance
+  bool kink_location; // can end a step exactly at every spring switch (locate_kinks)
+  bool lcp;           // solves one LCP per step: takes an LCP algorithm
+  bool chooses_form;  // picks its dense or banded form itself, by the structure
+  bool banded;        // banded operators: work and memory per step grow like n
+  bool exact;         // no discretisation error (the ground truth of small systems)
+  int order;          // order of accuracy in the step (fixed grid) or of the embedded pair
+                      // (adaptive); 0 for the exact solver. The switching PIM's is d + 3 with its
+                      // default force degree d = 2.
+  long max_dofs;      // the largest structure it accepts (degrees of freedom); 0: no limit
+  long max_springs;   // the most gap springs it accepts; 0: no limit
+};
+
+// Every row, in the order the command line lists them.
+std::span<const MethodTraits> method_table();
+// The row of one method.
+const MethodTraits& method_traits(Method method);
+// The method named `name` ("pim-switching"). Throws InputError naming the value and every
+// accepted name otherwise.
+Method parse_method(std::string_view name);
+// Every name, in table order (for the command line's choices and messages).
+std::vector<std::string> method_names();
+
+// How to build an integrator from the table: the settings of every method, each read only by the
+// methods whose row asks for it.
+struct MethodSettings {
+  Method method = Method::pim;
+  double step = 0.0;          // fixed_grid: η > 0
+  double tolerance = 1e-10;   // adaptive: relative and absolute tolerance
+  bool locate_kinks = false;  // kink_location: end a step at every spring switch
+  double max_step = 0.0;      // adaptive: the largest step (0: no limit)
+  LcpAlgorithm lcp = LcpAlgorithm::block_pivoting;  // lcp (dense forms; the banded ones have their own)
+  long banded_above = 50;     // chooses_form: banded beyond this many degrees of freedom
+
+  // Ceres-style check against the structure it will integrate: false with a message naming the
+  // setting and its value (a step that is not positive, a tolerance that is not, a structure
+  // beyond the method's size limits).
+  bool is_valid(const GapStructure& structure, std::string* why) const;
+};
+
+// The method's label with the settings a reader needs to repeat the run: "PIM", "switching PIM",
+// "dopri5, kink-located, tol 1e-10" (for tables, figure legends and study descriptions).
+std::string method_label(const MethodSettings& settings);
+
+// The integrator the settings name, built for `structure`, its state at rest at t = 0. Throws
+// InputError for invalid settings (the message of is_valid) or a structure the method refuses.
+std::unique_ptr<Integrator> make_integrator(const GapStructure& structure,
+                                            const MethodSettings& settings);
+
+}  // namespace pwl

@@ -1,0 +1,175 @@
+#include "pwl/integrators/method_table.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "pwl/errors.hpp"
+#include "pwl/integrators/banded_pim_integrator.hpp"
+#include "pwl/integrators/banded_switching_pim.hpp"
+#include "pwl/integrators/event_driven_solver.hpp"
+#include "pwl/integrators/pim_integrator.hpp"
+#include "pwl/integrators/reference_integrator.hpp"
+#include "pwl/integrators/switching_pim.hpp"
+
+namespace pwl {
+namespace {
+
+// The one table. Columns: method, name, label, summary, fixed_grid, tangent_map, adaptive,
+// kink_location, lcp, chooses_form, banded, exact, order, max_dofs, max_springs. A row that
+// chooses its form states the capabilities of its dense form; the integrator it builds reports the
+// form it took (Integrator::method()).
+constexpr std::array<MethodTraits, 9> kTable{{
+    {Method::pim, "pim", "PIM", "the paper's PIM (dense or banded by size)",
+     true, true, false, false, true, true, false, false, 2, 0, 0},
+    {Method::pim_dense, "pim-dense", "dense PIM", "the PIM with dense operators",
+     true, true, false, false, true, false, false, false, 2, 0, 0},
+    {Method::pim_banded, "pim-banded", "banded PIM", "the PIM with banded operators (long chains)",
+     true, false, false, false, false, false, true, false, 2, 0, 0},
+    {Method::pim_switching, "pim-switching", "switching PIM",
+     "higher order, located switches (dense or banded by size)",
+     true, false, false, false, true, true, false, false, 5, 0, 0},
+    {Method::pim_switching_dense, "pim-switching-dense", "switching PIM",
+     "the switching PIM with dense operators",
+     true, false, false, false, true, false, false, false, 5, 0, 0},
+    {Method::pim_switching_banded, "pim-switching-banded", "banded switching PIM",
+     "the switching PIM with banded operators",
+     true, false, false, false, false, false, true, false, 5, 0, 0},
+    {Method::exact, "exact", "exact event-driven", "event-driven, closed form per contact state",
+     false, false, false, false, false, false, false, true, 0, 0, 62},
+    {Method::dopri5, "dopri5", "dopri5", "Dormand-Prince 5(4), with --tol and --locate-kinks",
+     false, false, true, true, false, false, false, false, 5, 0, 0},
+    {Method::rkf78, "rkf78", "rkf78", "Runge-Kutta-Fehlberg 7(8), with --tol and --locate-kinks",
+     false, false, true, true, false, false, false, false, 8, 0, 0},
+}};
+
+static_assert([] {
+  for (std::size_t i = 0; i < kTable.size(); ++i) {
+    if (static_cast<std::size_t>(kTable[i].method) != i) return false;
+  }
+  return true;
+}(), "the method table's rows follow the order of enum Method");
+
+}  // namespace
+
+std::span<const MethodTraits> method_table() { return kTable; }
+
+const MethodTraits& method_traits(Method method) {
+  return kTable[static_cast<std::size_t>(method)];
+}
+
+std::vector<std::string> method_names() {
+  std::vector<std::string> names;
+  for (const MethodTraits& row : kTable) names.emplace_back(row.name);
+  return names;
+}
+
+Method parse_method(std::string_view name) {
+  for (const MethodTraits& row : kTable) {
+    if (row.name == name) return row.method;
+  }
+  throw InputError(fmt::format("method = \"{}\" is not known; use one of {}", name,
+                               fmt::join(method_names(), ", ")));
+}
+
+std::string method_label(const MethodSettings& s) {
+  const MethodTraits& row = method_traits(s.method);
+  if (!row.adaptive) return std::string(row.label);
+  return fmt::format("{}{}, tol {:g}", row.name, s.locate_kinks ? ", kink-located" : "",
+                     s.tolerance);
+}
+
+bool MethodSettings::is_valid(const GapStructure& structure, std::string* why) const {
+  std::string scratch;
+  if (why == nullptr) why = &scratch;
+  const MethodTraits& row = method_traits(method);
+  if (row.fixed_grid && (!std::isfinite(step) || step <= 0.0)) {
+    *why = fmt::format("{}: step = {} must be positive and finite", row.name, step);
+    return false;
+  }
+  if (row.adaptive && (!std::isfinite(tolerance) || tolerance <= 0.0)) {
+    *why = fmt::format("{}: tolerance = {} must be positive and finite", row.name, tolerance);
+    return false;
+  }
+  if (row.adaptive && (!std::isfinite(max_step) || max_step < 0.0)) {
+    *why = fmt::format("{}: max_step = {} must be >= 0 and finite", row.name, max_step);
+    return false;
+  }
+  if (row.max_dofs > 0 && structure.dofs() > row.max_dofs) {
+    *why = fmt::format("{}: the structure has {} degrees of freedom, the method takes at most {}",
+                       row.name, structure.dofs(), row.max_dofs);
+    return false;
+  }
+  if (row.max_springs > 0 && structure.spring_count() > row.max_springs) {
+    *why = fmt::format("{}: the structure has {} gap springs, the method takes at most {}",
+                       row.name, structure.spring_count(), row.max_springs);
+    return false;
+  }
+  if (banded_above < 0) {
+    *why = fmt::format("banded_above = {} must be >= 0", banded_above);
+    return false;
+  }
+  return true;
+}
+
+std::unique_ptr<Integrator> make_integrator(const GapStructure& structure,
+                                            const MethodSettings& s) {
+  std::string why;
+  if (!s.is_valid(structure, &why)) throw InputError(why);
+  const auto switching_options = [&] {
+    SwitchingPimOptions o;
+    o.step = s.step;
+    o.lcp_solver = s.lcp;
+    return o;
+  };
+  const auto banded_switching = [&] {
+    BandedSwitchingPimOptions b;
+    b.pim = switching_options();
+    return make_banded_switching_pim(structure, b);
+  };
+  std::unique_ptr<Integrator> result;
+  switch (s.method) {
+    case Method::pim:
+    case Method::pim_dense: {
+      PimOptions p;
+      p.step = s.step;
+      p.lcp_solver = s.lcp;
+      result = s.method == Method::pim ? make_pim_integrator_auto(structure, p, s.banded_above)
+                                       : make_pim_integrator(structure, p);
+      break;
+    }
+    case Method::pim_banded: {
+      BandedPimOptions b;
+      b.step = s.step;
+      result = make_banded_pim_integrator(structure, b);
+      break;
+    }
+    case Method::pim_switching:
+      if (structure.dofs() > s.banded_above && banded_layout(structure).banded) {
+        result = banded_switching();
+      } else {
+        result = make_switching_pim(structure, switching_options());
+      }
+      break;
+    case Method::pim_switching_dense: result = make_switching_pim(structure, switching_options()); break;
+    case Method::pim_switching_banded: result = banded_switching(); break;
+    case Method::exact: result = make_event_driven_solver(structure); break;
+    case Method::dopri5:
+    case Method::rkf78: {
+      ReferenceOptions r;
+      r.method = s.method == Method::dopri5 ? RungeKuttaMethod::dopri5 : RungeKuttaMethod::rkf78;
+      r.relative_tolerance = r.absolute_tolerance = s.tolerance;
+      r.locate_kinks = s.locate_kinks;
+      r.max_step = s.max_step;
+      result = make_reference_integrator(structure, r);
+      break;
+    }
+  }
+  result->set_state(0.0, Vector::Zero(structure.dofs()), Vector::Zero(structure.dofs()));
+  return result;
+}
+
+}  // namespace pwl
