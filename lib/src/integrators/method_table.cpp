@@ -18,32 +18,92 @@
 namespace pwl {
 namespace {
 
+// The makers: each fills its method's options from the common settings.
+PimOptions pim_options(const MethodSettings& s) {
+  PimOptions p;
+  p.step = s.step;
+  p.lcp_solver = s.lcp;
+  return p;
+}
+
+SwitchingPimOptions switching_options(const MethodSettings& s) {
+  SwitchingPimOptions o;
+  o.step = s.step;
+  o.lcp_solver = s.lcp;
+  return o;
+}
+
+std::unique_ptr<Integrator> make_pim(const GapStructure& g, const MethodSettings& s) {
+  return make_pim_integrator_auto(g, pim_options(s), s.banded_above);
+}
+
+std::unique_ptr<Integrator> make_pim_dense(const GapStructure& g, const MethodSettings& s) {
+  return make_pim_integrator(g, pim_options(s));
+}
+
+std::unique_ptr<Integrator> make_pim_banded(const GapStructure& g, const MethodSettings& s) {
+  BandedPimOptions b;
+  b.step = s.step;
+  return make_banded_pim_integrator(g, b);
+}
+
+std::unique_ptr<Integrator> make_switching_dense(const GapStructure& g, const MethodSettings& s) {
+  return make_switching_pim(g, switching_options(s));
+}
+
+std::unique_ptr<Integrator> make_switching_banded(const GapStructure& g, const MethodSettings& s) {
+  BandedSwitchingPimOptions b;
+  b.pim = switching_options(s);
+  return make_banded_switching_pim(g, b);
+}
+
+std::unique_ptr<Integrator> make_switching(const GapStructure& g, const MethodSettings& s) {
+  if (g.dofs() > s.banded_above && banded_layout(g).banded) return make_switching_banded(g, s);
+  return make_switching_dense(g, s);
+}
+
+std::unique_ptr<Integrator> make_exact(const GapStructure& g, const MethodSettings&) {
+  return make_event_driven_solver(g);
+}
+
+template <RungeKuttaMethod kMethod>
+std::unique_ptr<Integrator> make_runge_kutta(const GapStructure& g, const MethodSettings& s) {
+  ReferenceOptions r;
+  r.method = kMethod;
+  r.relative_tolerance = r.absolute_tolerance = s.tolerance;
+  r.locate_kinks = s.locate_kinks;
+  r.max_step = s.max_step;
+  return make_reference_integrator(g, r);
+}
+
 // The one table. Columns: method, name, label, summary, fixed_grid, tangent_map, adaptive,
-// kink_location, lcp, chooses_form, banded, exact, order, max_dofs, max_springs. A row that
+// kink_location, lcp, chooses_form, banded, exact, order, max_dofs, max_springs, make. A row that
 // chooses its form states the capabilities of its dense form; the integrator it builds reports the
 // form it took (Integrator::method()).
 constexpr std::array<MethodTraits, 9> kTable{{
     {Method::pim, "pim", "PIM", "the paper's PIM (dense or banded by size)",
-     true, true, false, false, true, true, false, false, 2, 0, 0},
+     true, true, false, false, true, true, false, false, 2, 0, 0, make_pim},
     {Method::pim_dense, "pim-dense", "dense PIM", "the PIM with dense operators",
-     true, true, false, false, true, false, false, false, 2, 0, 0},
+     true, true, false, false, true, false, false, false, 2, 0, 0, make_pim_dense},
     {Method::pim_banded, "pim-banded", "banded PIM", "the PIM with banded operators (long chains)",
-     true, false, false, false, false, false, true, false, 2, 0, 0},
+     true, false, false, false, false, false, true, false, 2, 0, 0, make_pim_banded},
     {Method::pim_switching, "pim-switching", "switching PIM",
      "higher order, located switches (dense or banded by size)",
-     true, false, false, false, true, true, false, false, 5, 0, 0},
+     true, false, false, false, true, true, false, false, 5, 0, 0, make_switching},
     {Method::pim_switching_dense, "pim-switching-dense", "switching PIM",
      "the switching PIM with dense operators",
-     true, false, false, false, true, false, false, false, 5, 0, 0},
+     true, false, false, false, true, false, false, false, 5, 0, 0, make_switching_dense},
     {Method::pim_switching_banded, "pim-switching-banded", "banded switching PIM",
      "the switching PIM with banded operators",
-     true, false, false, false, false, false, true, false, 5, 0, 0},
+     true, false, false, false, false, false, true, false, 5, 0, 0, make_switching_banded},
     {Method::exact, "exact", "exact event-driven", "event-driven, closed form per contact state",
-     false, false, false, false, false, false, false, true, 0, 0, 62},
+     false, false, false, false, false, false, false, true, 0, 0, 62, make_exact},
     {Method::dopri5, "dopri5", "dopri5", "Dormand-Prince 5(4), with --tol and --locate-kinks",
-     false, false, true, true, false, false, false, false, 5, 0, 0},
+     false, false, true, true, false, false, false, false, 5, 0, 0,
+     make_runge_kutta<RungeKuttaMethod::dopri5>},
     {Method::rkf78, "rkf78", "rkf78", "Runge-Kutta-Fehlberg 7(8), with --tol and --locate-kinks",
-     false, false, true, true, false, false, false, false, 8, 0, 0},
+     false, false, true, true, false, false, false, false, 8, 0, 0,
+     make_runge_kutta<RungeKuttaMethod::rkf78>},
 }};
 
 static_assert([] {
@@ -119,55 +179,7 @@ std::unique_ptr<Integrator> make_integrator(const GapStructure& structure,
                                             const MethodSettings& s) {
   std::string why;
   if (!s.is_valid(structure, &why)) throw InputError(why);
-  const auto switching_options = [&] {
-    SwitchingPimOptions o;
-    o.step = s.step;
-    o.lcp_solver = s.lcp;
-    return o;
-  };
-  const auto banded_switching = [&] {
-    BandedSwitchingPimOptions b;
-    b.pim = switching_options();
-    return make_banded_switching_pim(structure, b);
-  };
-  std::unique_ptr<Integrator> result;
-  switch (s.method) {
-    case Method::pim:
-    case Method::pim_dense: {
-      PimOptions p;
-      p.step = s.step;
-      p.lcp_solver = s.lcp;
-      result = s.method == Method::pim ? make_pim_integrator_auto(structure, p, s.banded_above)
-                                       : make_pim_integrator(structure, p);
-      break;
-    }
-    case Method::pim_banded: {
-      BandedPimOptions b;
-      b.step = s.step;
-      result = make_banded_pim_integrator(structure, b);
-      break;
-    }
-    case Method::pim_switching:
-      if (structure.dofs() > s.banded_above && banded_layout(structure).banded) {
-        result = banded_switching();
-      } else {
-        result = make_switching_pim(structure, switching_options());
-      }
-      break;
-    case Method::pim_switching_dense: result = make_switching_pim(structure, switching_options()); break;
-    case Method::pim_switching_banded: result = banded_switching(); break;
-    case Method::exact: result = make_event_driven_solver(structure); break;
-    case Method::dopri5:
-    case Method::rkf78: {
-      ReferenceOptions r;
-      r.method = s.method == Method::dopri5 ? RungeKuttaMethod::dopri5 : RungeKuttaMethod::rkf78;
-      r.relative_tolerance = r.absolute_tolerance = s.tolerance;
-      r.locate_kinks = s.locate_kinks;
-      r.max_step = s.max_step;
-      result = make_reference_integrator(structure, r);
-      break;
-    }
-  }
+  std::unique_ptr<Integrator> result = method_traits(s.method).make(structure, s);
   result->set_state(0.0, Vector::Zero(structure.dofs()), Vector::Zero(structure.dofs()));
   return result;
 }

@@ -5,8 +5,8 @@
 // it needs: a fixed step grid, an exact tangent map (Lyapunov exponents, Floquet multipliers),
 // banded operators, an error tolerance, kink location, a size limit, its order of accuracy. The
 // command line's choices, the labels of tables and figures, the checks of a study's settings and
-// the factory all read this table, so adding an integrator is one row here, one file that
-// implements it and one test. Code that needs a capability asks the row (`method_traits(m)`)
+// the factory all read this table, so adding an integrator is one file that implements it (with a
+// maker from MethodSettings), one enum value with its row here, and one test. Code that needs a capability asks the row (`method_traits(m)`)
 // or the integrator (`Integrator::method()`), never a name.
 #include <memory>
 #include <span>
@@ -20,6 +20,13 @@
 #include "pwl/numerics/lcp_solver.hpp"
 
 namespace pwl {
+
+struct MethodSettings;
+
+// Builds a method's integrator from the common settings (the row's own maker: the method's options
+// struct filled from the settings it reads).
+using IntegratorMaker = std::unique_ptr<Integrator> (*)(const GapStructure& structure,
+                                                         const MethodSettings& settings);
 
 struct MethodTraits {
   Method method;
@@ -40,6 +47,7 @@ struct MethodTraits {
                       // default force degree d = 2.
   long max_dofs;      // the largest structure it accepts (degrees of freedom); 0: no limit
   long max_springs;   // the most gap springs it accepts; 0: no limit
+  IntegratorMaker make;
 };
 
 // Every row, in the order the command line lists them.
