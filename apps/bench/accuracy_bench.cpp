@@ -11,14 +11,10 @@
 
 #include "output/csv_writer.hpp"
 #include "output/gnuplot.hpp"
-#include "pwl/integrators/banded_pim_integrator.hpp"
-#include "pwl/model/chain_builders.hpp"
 #include "pwl/errors.hpp"
 #include "pwl/integrators/event_driven_solver.hpp"
-#include "pwl/integrators/pim_integrator.hpp"
-#include "pwl/integrators/reference_integrator.hpp"
-#include "pwl/integrators/banded_switching_pim.hpp"
-#include "pwl/integrators/switching_pim.hpp"
+#include "pwl/integrators/method_table.hpp"
+#include "pwl/model/chain_builders.hpp"
 
 namespace pwl::app {
 namespace accuracy_detail {
@@ -215,22 +211,38 @@ std::vector<double> tolerances(bool quick, double tightest) {
   return t;
 }
 
-// The four Runge-Kutta variants over tolerances.
+// A factory of the method table's integrator for `settings`.
+Factory table_factory(const GapStructure& s, const MethodSettings& settings) {
+  return [&s, settings] { return make_integrator(s, settings); };
+}
+
+// The settings of a fixed-grid method at step η.
+MethodSettings at_step(Method method, double step) {
+  MethodSettings settings;
+  settings.method = method;
+  settings.step = step;
+  return settings;
+}
+
+// The four Runge-Kutta variants over tolerances: every adaptive row of the method table, plain
+// and kink-located.
 void runge_kutta_curves(const GapStructure& s, const std::vector<double>& tols,
                         const std::vector<double>& times, const std::vector<Vector>& truth,
                         const AccuracyOptions& o, std::vector<Curve>& curves) {
-  for (const char* method : {"dopri5", "rkf78"}) {
+  for (const MethodTraits& row : method_table()) {
+    if (!row.adaptive) continue;
     for (bool kinks : {false, true}) {
+      if (kinks && !row.kink_location) continue;
       Curve c;
-      c.key = fmt::format("{}{}", method, kinks ? "-kinks" : "");
-      c.label = fmt::format("{}{}", method, kinks ? " kink-located" : "");
+      c.key = fmt::format("{}{}", row.name, kinks ? "-kinks" : "");
+      c.label = fmt::format("{}{}", row.name, kinks ? " kink-located" : "");
       c.parameter_name = "tol";
       for (double tol : tols) {
-        ReferenceOptions ro;
-        ro.method = parse_runge_kutta_method(method);
-        ro.relative_tolerance = ro.absolute_tolerance = tol;
-        ro.locate_kinks = kinks;
-        const Factory make = [&s, ro] { return make_reference_integrator(s, ro); };
+        MethodSettings settings;
+        settings.method = row.method;
+        settings.tolerance = tol;
+        settings.locate_kinks = kinks;
+        const Factory make = table_factory(s, settings);
         c.points.push_back({tol, 0.0, accuracy_detail::measure(make, times, truth, o.repeats,
                                                                 o.budget)});
         fmt::print(stderr, ".");
@@ -255,12 +267,8 @@ void plot(const AccuracyOptions& o, const std::string& stem, const std::vector<C
         "data='{}'; stem='{}'; curves='{}'; out='{}.{}'; plot_title={}; ylabel_text={}", o.out,
         stem, keys, out, format, gnuplot_quoted(title), gnuplot_quoted(error_label));
   };
-  std::string why;
-  if (draw_figure(scripts_directory() + "/work_precision.gp", definitions, &why)) {
-    fmt::print("wrote {}.png and .svg\n", out);
-  } else {
-    fmt::print(stderr, "pwl bench accuracy: no figure: {}\n", why);
-  }
+  draw_figure_and_report(scripts_directory() + "/work_precision.gp", definitions, out,
+                         "pwl bench accuracy", false);
 }
 
 void five_dof(const AccuracyOptions& o) {
@@ -274,7 +282,9 @@ void five_dof(const AccuracyOptions& o) {
   // The truth, and the exact solver's own point: its cost, and its agreement with the same
   // solver in the augmented-exponential representation (independent arithmetic).
   std::vector<Curve> curves;
-  const Factory exact = [&s] { return make_event_driven_solver(s); };
+  MethodSettings exact_settings;
+  exact_settings.method = Method::exact;
+  const Factory exact = table_factory(s, exact_settings);
   Run truth_run = accuracy_detail::measure(exact, times, {}, o.repeats, o.budget);
   if (!truth_run.ok) throw Error("the exact solver failed on figure 4a: " + truth_run.failure);
   const std::vector<Vector> truth = truth_run.states;
@@ -285,8 +295,8 @@ void five_dof(const AccuracyOptions& o) {
     const Run check = accuracy_detail::measure(other, times, truth, 1, o.budget);
     truth_run.error = check.ok ? check.error : std::numeric_limits<double>::quiet_NaN();
     Curve c;
-    c.key = "exact";
-    c.label = "exact event-driven";
+    c.key = std::string(method_traits(Method::exact).name);
+    c.label = std::string(method_traits(Method::exact).label);
     c.parameter_name = "-";
     c.points.push_back({0.0, 0.0, truth_run});
     curves.push_back(std::move(c));
@@ -303,10 +313,10 @@ void five_dof(const AccuracyOptions& o) {
     c.parameter_name = "steps/period";
     c.fixed_step = true;
     for (int n : pim_steps) {
-      PimOptions po;
-      po.step = T / n;
-      const Factory make = [&s, po] { return make_pim_integrator(s, po); };
-      c.points.push_back({double(n), po.step, accuracy_detail::measure(make, times, truth, o.repeats, o.budget)});
+      const MethodSettings settings = at_step(Method::pim, T / n);
+      const Factory make = table_factory(s, settings);
+      c.points.push_back({double(n), settings.step,
+                          accuracy_detail::measure(make, times, truth, o.repeats, o.budget)});
       fmt::print(stderr, ".");
     }
     curves.push_back(std::move(c));
@@ -319,11 +329,11 @@ void five_dof(const AccuracyOptions& o) {
     c.fixed_step = true;
     for (int n : pim_steps) {
       if (n > 1600) continue;  // at rounding level already
-      SwitchingPimOptions so;
-      so.step = T / n;
-      so.force_degree = degree;
-      const Factory make = [&s, so] { return make_switching_pim(s, so); };
-      c.points.push_back({double(n), so.step, accuracy_detail::measure(make, times, truth, o.repeats, o.budget)});
+      MethodSettings settings = at_step(Method::pim_switching, T / n);
+      settings.force_degree = degree;
+      const Factory make = table_factory(s, settings);
+      c.points.push_back({double(n), settings.step,
+                          accuracy_detail::measure(make, times, truth, o.repeats, o.budget)});
       fmt::print(stderr, ".");
     }
     curves.push_back(std::move(c));
@@ -348,11 +358,11 @@ void large_chain(const AccuracyOptions& o) {
   for (int k = 1; k <= static_cast<int>(std::floor(t_end + 1e-9)); ++k) times.push_back(k);
   if (times.empty()) throw InputError(fmt::format("--chain-time = {} must be at least 1 s", t_end));
 
-  ReferenceOptions truth_options;
-  truth_options.method = RungeKuttaMethod::rkf78;
-  truth_options.relative_tolerance = truth_options.absolute_tolerance = o.chain_truth_tolerance;
-  truth_options.locate_kinks = true;
-  const Factory truth_factory = [&s, truth_options] { return make_reference_integrator(s, truth_options); };
+  MethodSettings truth_settings;
+  truth_settings.method = Method::rkf78;
+  truth_settings.tolerance = o.chain_truth_tolerance;
+  truth_settings.locate_kinks = true;
+  const Factory truth_factory = table_factory(s, truth_settings);
   const Run truth_run = accuracy_detail::measure(truth_factory, times, {}, 1, o.budget);
   if (!truth_run.ok) throw Error("the chain's truth (rkf78) failed: " + truth_run.failure);
   const std::vector<Vector> truth = truth_run.states;
@@ -369,10 +379,10 @@ void large_chain(const AccuracyOptions& o) {
     const std::vector<int> per_second = o.quick ? std::vector<int>{10, 50, 200}
                                                 : std::vector<int>{10, 25, 50, 100, 200, 400, 800};
     for (int n : per_second) {
-      PimOptions po;
-      po.step = 1.0 / n;
-      const Factory make = [&s, po] { return make_pim_integrator_auto(s, po); };
-      c.points.push_back({double(n), po.step, accuracy_detail::measure(make, times, truth, o.repeats, o.budget)});
+      const MethodSettings settings = at_step(Method::pim, 1.0 / n);
+      const Factory make = table_factory(s, settings);
+      c.points.push_back({double(n), settings.step,
+                          accuracy_detail::measure(make, times, truth, o.repeats, o.budget)});
       fmt::print(stderr, ".");
     }
     curves.push_back(std::move(c));
@@ -388,10 +398,10 @@ void large_chain(const AccuracyOptions& o) {
     const std::vector<int> per_second = o.quick ? std::vector<int>{10, 50}
                                                 : std::vector<int>{10, 25, 50, 100, 200};
     for (int n : per_second) {
-      BandedSwitchingPimOptions so;
-      so.pim.step = 1.0 / n;
-      const Factory make = [&s, so] { return make_banded_switching_pim(s, so); };
-      c.points.push_back({double(n), so.pim.step, accuracy_detail::measure(make, times, truth, o.repeats, o.budget)});
+      const MethodSettings settings = at_step(Method::pim_switching_banded, 1.0 / n);
+      const Factory make = table_factory(s, settings);
+      c.points.push_back({double(n), settings.step,
+                          accuracy_detail::measure(make, times, truth, o.repeats, o.budget)});
       fmt::print(stderr, ".");
     }
     curves.push_back(std::move(c));

@@ -14,10 +14,7 @@
 #include "pwl/analysis/period_detection.hpp"
 #include "pwl/model/chain_builders.hpp"
 #include "pwl/errors.hpp"
-#include "pwl/integrators/event_driven_solver.hpp"
-#include "pwl/integrators/pim_integrator.hpp"
-#include "pwl/integrators/reference_integrator.hpp"
-#include "pwl/integrators/switching_pim.hpp"
+#include "pwl/integrators/method_table.hpp"
 
 namespace pwl::app::accuracy_detail {
 namespace {
@@ -146,7 +143,10 @@ Outcome run_one(const GapStructure& s, const Factory& make, const std::vector<do
 struct MethodResults {
   std::string key;
   std::string label;
-  bool fixed_step = false;
+  // The method and whether it locates kinks; each cell sets the step (fixed grid) or the
+  // tolerance (adaptive).
+  MethodSettings settings;
+  bool fixed_step() const { return method_traits(settings.method).fixed_grid; }
   // Per α: the parameter (steps per period or tolerance) and its outcome.
   std::map<double, std::vector<std::pair<double, Outcome>>> by_alpha;
 };
@@ -180,12 +180,18 @@ void stability(StabilityOptions o) {
   std::filesystem::create_directories(o.out);
   std::filesystem::create_directories(o.plots);
 
+  const auto settings_of = [](Method method, bool locate_kinks) {
+    MethodSettings settings;
+    settings.method = method;
+    settings.locate_kinks = locate_kinks;
+    return settings;
+  };
   std::vector<MethodResults> methods = {
-      {"pim", "PIM (paper)", true, {}},
-      {"pim-switching", "switching PIM d=2", true, {}},
-      {"dopri5", "dopri5 (plain, like ode45)", false, {}},
-      {"dopri5-kinks", "dopri5 kink-located", false, {}},
-      {"rkf78-kinks", "rkf78 kink-located", false, {}},
+      {"pim", "PIM (paper)", settings_of(Method::pim, false), {}},
+      {"pim-switching", "switching PIM d=2", settings_of(Method::pim_switching, false), {}},
+      {"dopri5", "dopri5 (plain, like ode45)", settings_of(Method::dopri5, false), {}},
+      {"dopri5-kinks", "dopri5 kink-located", settings_of(Method::dopri5, true), {}},
+      {"rkf78-kinks", "rkf78 kink-located", settings_of(Method::rkf78, true), {}},
   };
   std::map<double, Reference> references;
 
@@ -199,7 +205,9 @@ void stability(StabilityOptions o) {
 
     Reference ref;
     {
-      const Factory exact = [&s] { return make_event_driven_solver(s); };
+      MethodSettings exact_settings;
+      exact_settings.method = Method::exact;
+      const Factory exact = [&s, exact_settings] { return make_integrator(s, exact_settings); };
       const Run r = measure(exact, times, {}, 1, o.budget);
       if (!r.ok) throw Error(fmt::format("the exact solver failed at α = {}: {}", alpha, r.failure));
       ref.states = r.states;
@@ -214,31 +222,22 @@ void stability(StabilityOptions o) {
 
     for (MethodResults& m : methods) {
       auto& cells = m.by_alpha[alpha];
-      if (m.fixed_step) {
-        for (int n : o.steps) {
-          Factory make;
-          if (m.key == "pim") {
-            PimOptions po;
-            po.step = T / n;
-            make = [&s, po] { return make_pim_integrator(s, po); };
-          } else {
-            SwitchingPimOptions so;
-            so.step = T / n;
-            make = [&s, so] { return make_switching_pim(s, so); };
-          }
-          const Counting counting = m.key == "pim" ? Counting::step_ends : Counting::located;
-          cells.emplace_back(n, run_one(s, make, times, ref, counting, o));
+      // Steps per period for a fixed-grid method, tolerances for an adaptive one.
+      std::vector<double> parameters(o.tolerances);
+      if (m.fixed_step()) parameters.assign(o.steps.begin(), o.steps.end());
+      for (double p : parameters) {
+        MethodSettings settings = m.settings;
+        if (m.fixed_step()) {
+          settings.step = T / p;
+        } else {
+          settings.tolerance = p;
         }
-      } else {
-        for (double tol : o.tolerances) {
-          ReferenceOptions ro;
-          ro.method = m.key.rfind("rkf78", 0) == 0 ? RungeKuttaMethod::rkf78 : RungeKuttaMethod::dopri5;
-          ro.relative_tolerance = ro.absolute_tolerance = tol;
-          ro.locate_kinks = m.key.find("kinks") != std::string::npos;
-          const Factory make = [&s, ro] { return make_reference_integrator(s, ro); };
-          const Counting counting = ro.locate_kinks ? Counting::located : Counting::step_ends;
-          cells.emplace_back(tol, run_one(s, make, times, ref, counting, o));
-        }
+        const Factory make = [&s, settings] { return make_integrator(s, settings); };
+        // A method that locates its switches counts them; the others are judged by the contact
+        // changes between the ends of their steps.
+        const Counting counting =
+            locates_switches(settings) ? Counting::located : Counting::step_ends;
+        cells.emplace_back(p, run_one(s, make, times, ref, counting, o));
       }
       fmt::print(stderr, "{} ", m.key);
     }
@@ -306,7 +305,7 @@ void stability(StabilityOptions o) {
       for (const auto& [p, out] : m.by_alpha.at(alpha)) {
         if (out.status == Status::ok) continue;
         failures += fmt::format("{}{}: {}", failures.empty() ? "" : "; ",
-                                m.fixed_step ? fmt::format("T/{:g}", p) : fmt::format("{:.0e}", p),
+                                m.fixed_step() ? fmt::format("T/{:g}", p) : fmt::format("{:.0e}", p),
                                 status_name(out.status));
       }
       double parameter = 0.0;
@@ -314,7 +313,7 @@ void stability(StabilityOptions o) {
       const std::string cost_text =
           std::isfinite(cost)
               ? fmt::format("{:.3g} s at {}", cost,
-                            m.fixed_step ? fmt::format("T/{:g}", parameter)
+                            m.fixed_step() ? fmt::format("T/{:g}", parameter)
                                          : fmt::format("tol {:.0e}", parameter))
               : std::string("not reached");
       fmt::print("| {:g} | {}, {}, {:.3g} s | {} | {} | {} |\n", alpha,
@@ -334,12 +333,8 @@ void stability(StabilityOptions o) {
         o.out, out, format, o.target, o.periods, o.accuracy_periods, o.periods,
         o.accuracy_periods);
   };
-  std::string why;
-  if (draw_figure(scripts_directory() + "/stability.gp", definitions, &why)) {
-    fmt::print("wrote {}.png and .svg\n", out);
-  } else {
-    fmt::print(stderr, "pwl bench stability: no figure: {}\n", why);
-  }
+  draw_figure_and_report(scripts_directory() + "/stability.gp", definitions, out,
+                         "pwl bench stability", false);
 }
 
 }  // namespace

@@ -8,15 +8,15 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 
 #include <fmt/format.h>
 
 #include "output/csv_writer.hpp"
-#include "pwl/integrators/banded_pim_integrator.hpp"
-#include "pwl/model/chain_builders.hpp"
 #include "pwl/errors.hpp"
-#include "pwl/integrators/pim_integrator.hpp"
-#include "pwl/integrators/reference_integrator.hpp"
+#include "pwl/integrators/banded_step_rule.hpp"
+#include "pwl/integrators/method_table.hpp"
+#include "pwl/model/chain_builders.hpp"
 
 namespace pwl::app {
 namespace {
@@ -33,19 +33,48 @@ double median(std::vector<double> v) {
   return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-// A method: builds its integrator (the timed set-up) and says how to describe it.
-struct Method {
+// A row of the benchmark: its key, label and parameters (those of the committed tables), the
+// method table's settings it runs, and whether it is the base the others are compared with. Its
+// integrator is built by make_integrator inside the timing (the set-up is part of the cost); a
+// row whose step comes from the step rule runs the rule again there too.
+struct BenchRow {
   std::string key, label, parameters;
   int runs;
-  std::function<std::unique_ptr<Integrator>()> build;
+  MethodSettings settings;
+  bool base = false;
+  std::optional<BandedStepRuleOptions> rule;
 };
 
-ReferenceOptions rk(double tol, bool kinks) {
-  ReferenceOptions r;
-  r.method = RungeKuttaMethod::dopri5;
-  r.relative_tolerance = r.absolute_tolerance = tol;
+// The settings of an adaptive row at tolerance `tol`, kink-located or plain.
+MethodSettings runge_kutta(Method method, double tol, bool kinks) {
+  MethodSettings r;
+  r.method = method;
+  r.tolerance = tol;
   r.locate_kinks = kinks;
   return r;
+}
+
+// The settings of a fixed-grid row at step η.
+MethodSettings fixed_step(Method method, double step) {
+  MethodSettings s;
+  s.method = method;
+  s.step = step;
+  return s;
+}
+
+// The work counter of a run, by the capability of the method that ran: right-hand-side
+// evaluations for an adaptive one, LCP pivots otherwise.
+long work_of(const Integrator& integrator) {
+  const IntegratorStats stats = integrator.stats();
+  return method_traits(integrator.method()).adaptive ? stats.rhs_evaluations : stats.lcp_pivots;
+}
+
+// The row every other is compared with (the banded PIM at the paper's step), if it ran.
+const ChainMethodResult* base_of(const ChainBenchResult& result) {
+  for (const ChainMethodResult& r : result.methods) {
+    if (r.base) return &r;
+  }
+  return nullptr;
 }
 
 }  // namespace
@@ -84,8 +113,7 @@ ChainBenchResult run_chain_bench(const ChainBenchOptions& o) {
   result.options = o;
 
   // The reference, computed once (and cached across runs of the benchmark).
-  ReferenceOptions ref = rk(o.reference_tolerance, true);
-  ref.method = RungeKuttaMethod::rkf78;
+  const MethodSettings ref = runge_kutta(Method::rkf78, o.reference_tolerance, true);
   result.reference_label = fmt::format(
       "paper chain n = {}, t in [0, {}] s, x1: rkf78 kink-located, tol {:g}, grid {:g} s",
       o.masses, o.t_end, o.reference_tolerance, o.reference_grid);
@@ -103,22 +131,19 @@ ChainBenchResult run_chain_bench(const ChainBenchOptions& o) {
   if (o.reference_check) {
     say("reference check: dopri5 kink-located at the same tolerance ...");
     const ReferenceTrack check = ReferenceTrack::compute(
-        structure, o.t_end, rk(o.reference_tolerance, true), o.reference_grid, 0);
+        structure, o.t_end, runge_kutta(Method::dopri5, o.reference_tolerance, true),
+        o.reference_grid, 0);
     result.reference_check = check.difference(result.reference);
     say(fmt::format("  largest |x1| difference {:.2e} m, |x1'| {:.2e} m/s",
                     result.reference_check->first, result.reference_check->second));
   }
 
   // The methods.
-  std::vector<Method> methods;
+  std::vector<BenchRow> methods;
   if (wanted("pim-banded")) {
     methods.push_back({"pim-banded", "banded PIM (paper step)",
                        fmt::format("η = {:g} s, band from tol 1e-15", o.paper_step), o.runs,
-                       [&] {
-                         BandedPimOptions b;
-                         b.step = o.paper_step;
-                         return make_banded_pim_integrator(structure, b);
-                       }});
+                       fixed_step(Method::pim_banded, o.paper_step), true, std::nullopt});
   }
   if (wanted("pim-rule")) {
     for (int q : o.rule_bands) {
@@ -127,26 +152,18 @@ ChainBenchResult run_chain_bench(const ChainBenchOptions& o) {
       rule.band = q;
       const BandedStepChoice choice = select_banded_step(structure, rule);
       result.rule_choices.push_back(choice);
+      MethodSettings settings = fixed_step(Method::pim_banded, choice.step);
+      settings.band = q;
       methods.push_back(
           {"pim-rule", fmt::format("banded PIM (rule, q = {})", q),
            fmt::format("η1 = {:g} s -> η = {:g} s, q = {}", o.wished_step, choice.step, q),
-           o.runs, [&, rule, q] {
-             // The rule is part of the set-up: it is run again inside the timing.
-             const BandedStepChoice c = select_banded_step(structure, rule);
-             BandedPimOptions b;
-             b.step = c.step;
-             b.band.band = q;
-             return make_banded_pim_integrator(structure, b);
-           }});
+           o.runs, settings, false, rule});
     }
   }
   if (wanted("pim-dense")) {
     methods.push_back({"pim-dense", "dense PIM", fmt::format("η = {:g} s", o.paper_step),
-                       o.dense_runs, [&] {
-                         PimOptions p;
-                         p.step = o.paper_step;
-                         return make_pim_integrator(structure, p);
-                       }});
+                       o.dense_runs, fixed_step(Method::pim_dense, o.paper_step), false,
+                       std::nullopt});
   }
   for (auto [key, tol, kinks] :
        std::vector<std::tuple<std::string, double, bool>>{{"dopri5-1e-5", 1e-5, false},
@@ -156,24 +173,32 @@ ChainBenchResult run_chain_bench(const ChainBenchOptions& o) {
     if (!wanted(key)) continue;
     methods.push_back({key, kinks ? "dopri5, kink-located" : "dopri5 (plain, like ode45)",
                        fmt::format("rtol = atol = {:g}", tol), o.runs,
-                       [&, tol, kinks] { return make_reference_integrator(structure, rk(tol, kinks)); }});
+                       runge_kutta(Method::dopri5, tol, kinks), false, std::nullopt});
   }
+  // The set-up timed for a row: the step rule (when the row takes its step from it) and the
+  // integrator's operators.
+  const auto build = [&structure](const BenchRow& m) {
+    MethodSettings settings = m.settings;
+    if (m.rule) settings.step = select_banded_step(structure, *m.rule).step;
+    return make_integrator(structure, settings);
+  };
 
   const Vector rest = Vector::Zero(o.masses);
-  for (const Method& m : methods) {
+  for (const BenchRow& m : methods) {
     say(fmt::format("{} ({}): {} run{} ...", m.label, m.parameters, m.runs, m.runs > 1 ? "s" : ""));
     ChainMethodResult r;
     r.key = m.key;
     r.label = m.label;
     r.parameters = m.parameters;
     r.runs = m.runs;
+    r.base = m.base;
     std::vector<double> walls, cpus, setups;
     for (int run = 0; run < m.runs; ++run) {
       TrackRecord record;
       record.add(0.0, 0.0, 0.0);
       const double c0 = cpu_seconds();
       const auto w0 = std::chrono::steady_clock::now();
-      std::unique_ptr<Integrator> integrator = m.build();
+      std::unique_ptr<Integrator> integrator = build(m);
       const auto w1 = std::chrono::steady_clock::now();
       integrator->set_state(0.0, rest, rest);
       integrator->advance_to(o.t_end, [&record](double t, const Vector& x, const Vector& v) {
@@ -184,9 +209,8 @@ ChainBenchResult run_chain_bench(const ChainBenchOptions& o) {
       walls.push_back(std::chrono::duration<double>(w2 - w0).count());
       setups.push_back(std::chrono::duration<double>(w1 - w0).count());
       if (run == 0) {
-        const IntegratorStats stats = integrator->stats();
-        r.steps = stats.steps;
-        r.work = m.key.rfind("pim", 0) == 0 ? stats.lcp_pivots : stats.rhs_evaluations;
+        r.steps = integrator->stats().steps;
+        r.work = work_of(*integrator);
         r.record = std::move(record);
       }
       say(fmt::format("  run {}: {:.3f} s wall ({:.3f} s set-up), {:.3f} s CPU", run + 1,
@@ -201,10 +225,7 @@ ChainBenchResult run_chain_bench(const ChainBenchOptions& o) {
   }
 
   // CSV: one row per method.
-  const ChainMethodResult* base = nullptr;
-  for (const ChainMethodResult& r : result.methods) {
-    if (r.key == "pim-banded") base = &r;
-  }
+  const ChainMethodResult* base = base_of(result);
   {
     std::FILE* f = std::fopen((o.out + "/bench_chain.csv").c_str(), "w");
     if (f == nullptr) throw Error(fmt::format("cannot write {}/bench_chain.csv", o.out));
@@ -244,10 +265,7 @@ std::string format_chain_table(const ChainBenchResult& result) {
                                                         c.exceeded_after),
                      c.leaked_at_step, c.substructures);
   }
-  const ChainMethodResult* base = nullptr;
-  for (const ChainMethodResult& r : result.methods) {
-    if (r.key == "pim-banded") base = &r;
-  }
+  const ChainMethodResult* base = base_of(result);
   s += "\n| method | parameters | runs | wall s | CPU s | set-up s | steps | max err x1 (m) | "
        "max err x1' (m/s) | time / banded | err x1 / banded |\n"
        "|---|---|---|---|---|---|---|---|---|---|---|\n";

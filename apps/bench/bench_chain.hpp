@@ -39,6 +39,7 @@ struct ChainMethodResult {
   std::string label;       // e.g. "banded PIM (paper step)"
   std::string parameters;  // e.g. "η = 0.02 s, q = 5"
   int runs = 0;
+  bool base = false;        // the row the others are compared with (banded PIM, paper step)
   double wall = 0.0;        // median wall time of a run (set-up + integration), s
   double cpu = 0.0;         // median CPU time (all threads), s
   double setup = 0.0;       // median wall time of the set-up alone, s

@@ -38,10 +38,14 @@ double acceleration(const GapStructure& s, const std::vector<int>& springs, Inde
 }  // namespace
 
 ReferenceTrack ReferenceTrack::compute(const GapStructure& structure, double t_end,
-                                       const ReferenceOptions& options, double grid, Index dof) {
+                                       const MethodSettings& settings, double grid, Index dof) {
   if (!(grid > 0.0) || !(t_end > 0.0)) {
     throw InputError(fmt::format("reference track: grid = {} and t_end = {} must be positive",
                                  grid, t_end));
+  }
+  if (!locates_switches(settings)) {
+    throw InputError(fmt::format("reference track: {} does not end a step at every spring switch",
+                                 method_label(settings)));
   }
   std::vector<int> springs;
   for (std::size_t j = 0; j < structure.springs.size(); ++j) {
@@ -50,7 +54,7 @@ ReferenceTrack ReferenceTrack::compute(const GapStructure& structure, double t_e
     }
   }
   ReferenceTrack track;
-  auto integrator = make_reference_integrator(structure, options);
+  auto integrator = make_integrator(structure, settings);
   const Vector rest = Vector::Zero(structure.dofs());
   integrator->set_state(0.0, rest, rest);
   const auto record = [&](double t, const Vector& x, const Vector& v) {

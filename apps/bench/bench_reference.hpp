@@ -12,17 +12,19 @@
 #include <string>
 #include <vector>
 
+#include "pwl/integrators/method_table.hpp"
 #include "pwl/model/gap_structure.hpp"
-#include "pwl/integrators/reference_integrator.hpp"
 
 namespace pwl::app {
 
 class ReferenceTrack {
  public:
   // Integrates `structure` from rest over [0, t_end], recording degree of freedom `dof` at every
-  // step end of the reference integrator, which is advanced over a grid of spacing `grid`.
+  // step end of the reference integrator, which is advanced over a grid of spacing `grid`. The
+  // settings must build an integrator that ends a step at every spring switch
+  // (locates_switches), or the interpolant would cross kinks: InputError otherwise.
   static ReferenceTrack compute(const GapStructure& structure, double t_end,
-                                const ReferenceOptions& options, double grid, Index dof);
+                                const MethodSettings& settings, double grid, Index dof);
 
   double position(double t) const;
   double velocity(double t) const;

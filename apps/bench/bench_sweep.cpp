@@ -184,8 +184,9 @@ void run(const SweepBenchOptions& o) {
   std::vector<long> subset;
   for (int i = 0; i < o.points; i += o.dopri5_every) subset.push_back(i);
   analysis::PointSettings by_dopri5 = sweep.point;
-  by_dopri5.method = "dopri5";
-  by_dopri5.tolerance = tolerance;
+  by_dopri5.method.method = Method::dopri5;  // kink-located, as the sweep's points always were
+  by_dopri5.method.tolerance = tolerance;
+  by_dopri5.method.locate_kinks = true;
   std::vector<double> dopri_walls, pim_walls;
   for (int r = 0; r < o.repeats; ++r) {
     say(fmt::format("dopri5 (tol {:.0e}) on {} points, run {} of {} ...", tolerance, subset.size(),

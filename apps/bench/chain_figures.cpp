@@ -14,7 +14,7 @@ bool draw_chain_figures(const ChainBenchResult& r, const std::string& dir, std::
   const ChainMethodResult* pim = nullptr;
   const ChainMethodResult* rk = nullptr;
   for (const ChainMethodResult& m : r.methods) {
-    if (m.key == "pim-banded") pim = &m;
+    if (m.base) pim = &m;
     if (m.key == "dopri5-1e-5") rk = &m;
   }
   if (pim == nullptr || rk == nullptr) {

@@ -29,7 +29,10 @@ set ylabel yname
 set key outside right top
 set grid
 stats poincare using 1 nooutput
-set xrange [STATS_min:STATS_max]
+# A sweep of one value (or of one value left after the unbounded points) has an empty range: give
+# it a small width around that value. A range of positive width is drawn as it is.
+xwidth = STATS_max > STATS_min ? 0 : (STATS_min == 0 ? 0.5 : 0.05 * abs(STATS_min))
+set xrange [STATS_min - xwidth : STATS_max + xwidth]
 plot poincare using 1:(strcol(2) eq 'up' ? column(column) : NaN) with points pt 7 ps 0.12 lc rgb '#1f3fbf' \
        notitle, \
      poincare using 1:(strcol(2) eq 'down' ? column(column) : NaN) with points pt 7 ps 0.12 lc rgb '#d9531e' \

@@ -10,6 +10,9 @@ if (!exists("yname")) yname = 'alpha'
 if (!exists("subtitle")) subtitle = ''
 if (!exists("dx")) dx = 0.1
 if (!exists("dy")) dy = 1.0
+# A grid step of zero (one value on an axis) would give an empty range: draw the cell one unit wide.
+if (dx <= 0) dx = 1.0
+if (dy <= 0) dy = 1.0
 set datafile separator ','
 call 'terminal.gp' 1200 800 12
 color(c) = c == 1 ? 0x1f77b4 : c == 2 ? 0x2ca02c : c == 3 ? 0x17becf : c == 4 ? 0x9467bd : \

@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "pwl/errors.hpp"
+#include "test_series.hpp"
 
 using pwl::Matrix;
 using pwl::Vector;
@@ -17,25 +18,9 @@ using Catch::Matchers::Contains;
 
 namespace {
 
-TangentMap logistic(double r) {
-  return [r](const Vector& x, Matrix* J) {
-    if (J != nullptr) *J = Matrix::Constant(1, 1, r * (1.0 - 2.0 * x[0]));
-    return Vector::Constant(1, r * x[0] * (1.0 - x[0]));
-  };
-}
-
-// Hénon (1976): (x, y) -> (1 - a x^2 + y, b x); det J = -b everywhere.
-TangentMap henon(double a = 1.4, double b = 0.3) {
-  return [a, b](const Vector& s, Matrix* J) {
-    if (J != nullptr) {
-      J->resize(2, 2);
-      *J << -2.0 * a * s[0], 1.0, b, 0.0;
-    }
-    Vector next(2);
-    next << 1.0 - a * s[0] * s[0] + s[1], b * s[0];
-    return next;
-  };
-}
+// The logistic and Hénon maps with their Jacobians (test_series.hpp).
+TangentMap logistic(double r) { return pwl::test::logistic_map(r); }
+TangentMap henon(double a = 1.4, double b = 0.3) { return pwl::test::henon_map(a, b); }
 
 Vector henon_start() {
   Vector x(2);

@@ -9,6 +9,7 @@
 
 #include "pwl/analysis/lyapunov.hpp"
 #include "pwl/errors.hpp"
+#include "test_series.hpp"
 
 using pwl::Matrix;
 using pwl::Vector;
@@ -17,24 +18,9 @@ using Catch::Matchers::Contains;
 
 namespace {
 
-TangentMap logistic(double r) {
-  return [r](const Vector& x, Matrix* J) {
-    if (J != nullptr) *J = Matrix::Constant(1, 1, r * (1.0 - 2.0 * x[0]));
-    return Vector::Constant(1, r * x[0] * (1.0 - x[0]));
-  };
-}
-
-TangentMap henon() {
-  return [](const Vector& s, Matrix* J) {
-    if (J != nullptr) {
-      J->resize(2, 2);
-      *J << -2.8 * s[0], 1.0, 0.3, 0.0;
-    }
-    Vector next(2);
-    next << 1.0 - 1.4 * s[0] * s[0] + s[1], 0.3 * s[0];
-    return next;
-  };
-}
+// The logistic map and the Hénon map at a = 1.4, b = 0.3 (test_series.hpp).
+TangentMap logistic(double r) { return pwl::test::logistic_map(r); }
+TangentMap henon() { return pwl::test::henon_map(1.4, 0.3); }
 
 // The rotation of the circle by the golden mean, seen through the smooth change of angle
 // theta = h(phi) = phi + eps sin(phi), as a map of the plane that keeps the radius:

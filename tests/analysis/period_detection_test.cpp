@@ -7,6 +7,7 @@
 #include <numbers>
 
 #include "pwl/errors.hpp"
+#include "test_series.hpp"
 
 using pwl::Vector;
 using namespace pwl::analysis;
@@ -14,15 +15,9 @@ using Catch::Matchers::Contains;
 
 namespace {
 
-// Logistic-map values after a transient.
-std::vector<double> logistic_orbit(double r, int count, int transient = 2000, double x = 0.3) {
-  for (int i = 0; i < transient; ++i) x = r * x * (1.0 - x);
-  std::vector<double> values;
-  for (int i = 0; i < count; ++i) {
-    x = r * x * (1.0 - x);
-    values.push_back(x);
-  }
-  return values;
+// Logistic-map values after a transient of 2000 from x = 0.3 (test_series.hpp).
+std::vector<double> logistic_orbit(double r, int count) {
+  return pwl::test::logistic_series(r, count, 2000, 0.3);
 }
 
 // Points of the rotation of the unit circle by the golden mean.

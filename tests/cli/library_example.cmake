@@ -26,3 +26,31 @@ execute_process(COMMAND ${WORK_DIR}/build/poincare_points RESULT_VARIABLE rc)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "the example failed (${rc})")
 endif()
+
+# The installed program draws with the scripts under its own prefix, not the source tree's: it
+# draws a figure, and no longer does once the prefix's scripts are moved away.
+set(pwl ${WORK_DIR}/prefix/bin/pwl)
+set(scripts ${WORK_DIR}/prefix/share/pwl/scripts)
+if(NOT EXISTS ${scripts}/phase_portrait.gp OR NOT EXISTS ${WORK_DIR}/prefix/share/pwl/scenes/paper_fig4a.toml)
+  message(FATAL_ERROR "cmake --install put no scripts or scenes under share/pwl")
+endif()
+foreach(run installed moved)
+  if(run STREQUAL "moved")
+    file(RENAME ${scripts} ${scripts}_moved)
+  endif()
+  execute_process(COMMAND ${CMAKE_COMMAND} -E env --unset=PWL_PLOTS_DIR --unset=PWL_SCENES_DIR
+                          ${pwl} simulate --figure 4a --periods 3 --record 5 --quiet
+                          --out ${WORK_DIR}/${run}
+                  WORKING_DIRECTORY ${WORK_DIR} RESULT_VARIABLE rc ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "the installed pwl failed (${rc}): ${err}")
+  endif()
+  if(run STREQUAL "installed" AND NOT EXISTS ${WORK_DIR}/installed/phase.png)
+    message(FATAL_ERROR "the installed pwl drew no figure: ${err}")
+  endif()
+  if(run STREQUAL "moved" AND (EXISTS ${WORK_DIR}/moved/phase.png OR NOT err MATCHES "share/pwl/scripts"))
+    message(FATAL_ERROR "the installed pwl did not read its scripts from its prefix: ${err}")
+  endif()
+endforeach()
+file(RENAME ${scripts}_moved ${scripts})
+message(STATUS "the installed pwl draws with ${scripts}")

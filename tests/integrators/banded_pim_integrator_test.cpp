@@ -2,10 +2,13 @@
 // step, on chains with contacts, uniform and with cells that differ.
 #include <catch2/catch.hpp>
 
+#include <cstdint>
 #include <random>
 
 #include "pwl/integrators/banded_pim_integrator.hpp"
 #include "pwl/integrators/banded_propagator.hpp"
+#include "pwl/integrators/banded_step_operators.hpp"
+#include "pwl/integrators/method_table.hpp"
 #include "pwl/model/chain_builders.hpp"
 #include "pwl/errors.hpp"
 #include "pwl/integrators/pim_integrator.hpp"
@@ -97,7 +100,24 @@ TEST_CASE("The banded stepper reports its observer steps and spring forces", "[b
   propagator.position(x);
   propagator.velocity(v);
   CHECK(x.size() == 60);
-  CHECK(propagator.memory_bytes() > 0);
+  // The bytes the step operators must occupy, from their sizes: every distinct stored row's
+  // values, and per row its first column and its index into the shared rows; with the state, the
+  // predicted state and the spring forces now and next. The propagator holds those and its
+  // bookkeeping (transposed force columns, the loads' harmonics, the springs' rows), which is no
+  // larger than the operators themselves.
+  {
+    const BandedStepOperators ops = make_banded_step_operators(s, o.step);
+    const auto bytes_of = [](const BandedMatrix& a) {
+      return static_cast<std::size_t>(a.stored_rows() * a.width()) * sizeof(double) +
+             static_cast<std::size_t>(a.rows()) * (sizeof(Index) + sizeof(std::int32_t));
+    };
+    const std::size_t operators = bytes_of(ops.transition) + bytes_of(ops.force_now) +
+                                  bytes_of(ops.force_next) + bytes_of(ops.lcp_matrix);
+    const std::size_t state = static_cast<std::size_t>(4 * 60 + 2 * 60) * sizeof(double);
+    CAPTURE(propagator.memory_bytes(), operators, state);
+    CHECK(propagator.memory_bytes() >= operators + state);
+    CHECK(propagator.memory_bytes() <= 2 * (operators + state));
+  }
 
   auto integrator = make_banded_pim_integrator(s, o);
   integrator->set_state(0.0, Vector::Zero(60), Vector::Zero(60));
@@ -112,23 +132,25 @@ TEST_CASE("The banded stepper reports its observer steps and spring forces", "[b
   CHECK(calls == 20);
   CHECK(integrator->stats().steps == 20);
   CHECK_THROWS_AS(integrator->advance_to(2.05), InputError);
-  CHECK(integrator->name().find("banded") != std::string::npos);
+  CHECK(integrator->method() == Method::pim_banded);
+  CHECK(method_traits(integrator->method()).banded);
 }
 
 TEST_CASE("make_pim_integrator_auto picks banded for long banded chains", "[banded]") {
   PimOptions o;
   o.step = 0.05;
-  CHECK(make_pim_integrator_auto(make_chain(paper_large_chain(80)), o)->name().find("banded") !=
-        std::string::npos);
-  CHECK(make_pim_integrator_auto(make_chain(paper_large_chain(10)), o)->name().find("banded") ==
-        std::string::npos);
+  const auto form = [&](const GapStructure& s) { return make_pim_integrator_auto(s, o)->method(); };
+  CHECK(form(make_chain(paper_large_chain(80))) == Method::pim_banded);
+  CHECK(method_traits(form(make_chain(paper_large_chain(80)))).banded);
+  CHECK(form(make_chain(paper_large_chain(10))) == Method::pim_dense);
+  CHECK_FALSE(method_traits(form(make_chain(paper_large_chain(10)))).banded);
   // A spring from one end of the chain to the other is not banded: dense.
   GapStructure far = make_chain(paper_large_chain(80));
   far.springs.push_back({0, 79, 1.0, 1.0, 0.5});
   const BandedLayout layout = banded_layout(far);
   CHECK_FALSE(layout.banded);
   CHECK(layout.spring_reach == 79);
-  CHECK(make_pim_integrator_auto(far, o)->name().find("banded") == std::string::npos);
+  CHECK(form(far) == Method::pim_dense);
   CHECK(banded_layout(make_chain(paper_large_chain(80))).cell_dofs == 1);
 }
 

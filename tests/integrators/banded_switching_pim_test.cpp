@@ -16,26 +16,14 @@
 #include "pwl/errors.hpp"
 #include "pwl/integrators/reference_integrator.hpp"
 #include "pwl/integrators/switching_pim.hpp"
+#include "test_series.hpp"
+#include "test_structures.hpp"
 
 using namespace pwl;
+using pwl::test::fitted_order;
+using pwl::test::largest_difference;
 
 namespace {
-
-double largest_difference(const Integrator& a, const Integrator& b) {
-  return std::max((a.position() - b.position()).cwiseAbs().maxCoeff(),
-                  (a.velocity() - b.velocity()).cwiseAbs().maxCoeff());
-}
-
-// Least-squares slope of log(error) against log(step).
-double fitted_order(const std::vector<double>& steps, const std::vector<double>& errors) {
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  const double n = static_cast<double>(steps.size());
-  for (std::size_t i = 0; i < steps.size(); ++i) {
-    const double x = std::log(steps[i]), y = std::log(errors[i]);
-    sx += x, sy += y, sxx += x * x, sxy += x * y;
-  }
-  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
-}
 
 BandedSwitchingPimOptions banded_options(double step) {
   BandedSwitchingPimOptions o;

@@ -9,18 +9,12 @@
 #include "pwl/errors.hpp"
 #include "pwl/integrators/event_driven_solver.hpp"
 #include "pwl/integrators/reference_integrator.hpp"
+#include "test_structures.hpp"
 
 using namespace pwl;
+using pwl::test::single_mass;
 
 namespace {
-
-GapStructure single_mass(double m, double c, double k) {
-  GapStructure s;
-  s.mass = to_sparse(Matrix::Constant(1, 1, m));
-  s.damping = to_sparse(Matrix::Constant(1, 1, c));
-  s.stiffness = to_sparse(Matrix::Constant(1, 1, k));
-  return s;
-}
 
 EventDrivenOptions representation(const std::string& name) {
   EventDrivenOptions o;

@@ -13,36 +13,14 @@
 #include "pwl/integrators/pim_step_operators.hpp"
 #include "pwl/numerics/precise_exponential.hpp"
 #include "pwl/integrators/switching_pim.hpp"
+#include "test_series.hpp"
+#include "test_structures.hpp"
 
 using namespace pwl;
+using pwl::test::fitted_order;
+using pwl::test::largest_difference;
+using pwl::test::single_mass;
 
-namespace {
-
-GapStructure single_mass(double m, double c, double k) {
-  GapStructure s;
-  s.mass = to_sparse(Matrix::Constant(1, 1, m));
-  s.damping = to_sparse(Matrix::Constant(1, 1, c));
-  s.stiffness = to_sparse(Matrix::Constant(1, 1, k));
-  return s;
-}
-
-double largest_difference(const Integrator& a, const Integrator& b) {
-  return std::max((a.position() - b.position()).cwiseAbs().maxCoeff(),
-                  (a.velocity() - b.velocity()).cwiseAbs().maxCoeff());
-}
-
-// Least-squares slope of log(error) against log(step).
-double fitted_order(const std::vector<double>& steps, const std::vector<double>& errors) {
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  const double n = static_cast<double>(steps.size());
-  for (std::size_t i = 0; i < steps.size(); ++i) {
-    const double x = std::log(steps[i]), y = std::log(errors[i]);
-    sx += x, sy += y, sxx += x * x, sxy += x * y;
-  }
-  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
-}
-
-}  // namespace
 
 TEST_CASE("force moments: closed form for a scalar and the Γ0, Γ1 of precise_exponential",
           "[switching]") {

@@ -11,6 +11,7 @@
 #include "pwl/errors.hpp"
 #include "pwl/integrators/pim_step_operators.hpp"
 #include "pwl/numerics/precise_exponential.hpp"
+#include "test_structures.hpp"
 
 using namespace pwl;
 
@@ -58,21 +59,9 @@ double banded_error(const BandedMatrix& B, const Matrix& D, Index n) {
   return worst;
 }
 
+// Random cells, gap springs too (test_structures.hpp).
 ChainParameters varying_chain(int n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(0.5, 2.0);
-  ChainParameters p = paper_large_chain(n);
-  p.mass.clear();
-  p.k1.clear();
-  p.damping.clear();
-  p.k2.clear();
-  for (int i = 0; i < n; ++i) {
-    p.mass.push_back(u(rng));
-    p.k1.push_back(u(rng));
-    p.damping.push_back(0.2 * u(rng));
-    p.k2.push_back(u(rng));
-  }
-  return p;
+  return pwl::test::varying_chain(n, seed, 0.2, true);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include "pwl/errors.hpp"
 #include "pwl/integrators/pim_step_operators.hpp"
 #include "pwl/numerics/substructure_exponential.hpp"
+#include "test_structures.hpp"
 
 using namespace pwl;
 
@@ -16,19 +17,9 @@ namespace {
 
 double max_abs(const Matrix& A) { return A.size() ? A.cwiseAbs().maxCoeff() : 0.0; }
 
+// Random cells, uniform gap springs (test_structures.hpp).
 ChainParameters varying_chain(int n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(0.5, 2.0);
-  ChainParameters p = paper_large_chain(n);
-  p.mass.clear();
-  p.k1.clear();
-  p.damping.clear();
-  for (int i = 0; i < n; ++i) {
-    p.mass.push_back(u(rng));
-    p.k1.push_back(u(rng));
-    p.damping.push_back(0.1 * u(rng));
-  }
-  return p;
+  return pwl::test::varying_chain(n, seed, 0.1, false);
 }
 
 }  // namespace

@@ -701,3 +701,70 @@ TEST_CASE("LCP solvers reject bad input with InputError", "[lcp]") {
     CHECK(w == (Vector(2) << 0, 1).finished());
   }
 }
+
+#include "pwl/numerics/block_pivoting.hpp"
+
+namespace {
+
+// The pivoting rule of block_pivoting.hpp with the plainest principal solve (an Eigen LU of M_AA
+// each iteration): every form built on it must pivot as the dense solver does.
+struct PlainPolicy : pwl::block_pivoting::MaskedActiveSet {
+  const Matrix& M;
+  const Vector& q;
+  pwl::block_pivoting::Tolerances tol;
+  Vector x;
+
+  PlainPolicy(const Matrix& m, const Vector& rhs, const pwl::block_pivoting::Tolerances& t)
+      : M(m), q(rhs), tol(t), x(rhs.size()) {}
+  int evaluate(long) {
+    const int n = static_cast<int>(q.size());
+    Matrix T;
+    REQUIRE(pwl::block_pivoting::active_set_transform(M, n, mask, T));
+    x = T * q;
+    return mark_infeasible(x, n, tol);
+  }
+  pwl::LcpError iteration_error(long iteration) const {
+    return pwl::LcpError("no solution after " + std::to_string(iteration) + " iterations");
+  }
+};
+
+}  // namespace
+
+TEST_CASE("the block pivoting core with any principal solve matches the dense solver", "[lcp]") {
+  std::mt19937 rng(20261123);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  for (Index n = 1; n <= 8; ++n) {
+    for (const Family family : kFamilies) {
+      for (int rep = 0; rep < 5; ++rep) {
+        const Matrix M = random_p_matrix(rng, n, family);
+        Vector q(n);
+        for (Index i = 0; i < n; ++i) q[i] = U(rng);
+        INFO("n = " << n << ", family " << static_cast<int>(family) << ", rep " << rep);
+        auto dense = pwl::make_block_pivoting_solver();
+        dense->set_matrix(M);
+        const Solved expected = run(*dense, q);
+        const pwl::block_pivoting::Tolerances tol =
+            pwl::block_pivoting::tolerances(inf_norm(q), M.cwiseAbs().maxCoeff());
+        Vector z = Vector::Zero(n), w = Vector::Zero(n);
+        int pivots = 0;
+        if (!pwl::block_pivoting::zero_solves(q.minCoeff(), tol)) {
+          PlainPolicy policy(M, q, tol);
+          pivots = pwl::block_pivoting::solve(policy, static_cast<int>(n), 100000);
+          pwl::block_pivoting::split_basic_vector(
+              policy.x, n, [&](Index i) { return (policy.mask >> i & 1u) != 0; }, z, w);
+        } else {
+          w = q.cwiseMax(0.0);
+        }
+        CHECK(pivots == expected.pivots);
+        CHECK(inf_norm(z - expected.z) <= 1e-9 * std::max(1.0, inf_norm(expected.z)));
+        CHECK(inf_norm(w - expected.w) <= 1e-9 * std::max(1.0, inf_norm(q)));
+      }
+    }
+  }
+  // A singular principal block is reported, not used.
+  Matrix S = Matrix::Identity(3, 3);
+  S(1, 1) = 0.0;
+  Matrix T;
+  CHECK_FALSE(pwl::block_pivoting::active_set_transform(S, 3, 0b010u, T));
+  CHECK(pwl::block_pivoting::active_set_transform(S, 3, 0b101u, T));
+}

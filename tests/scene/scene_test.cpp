@@ -3,6 +3,7 @@
 #include "scene/scene.hpp"
 
 #include <catch2/catch.hpp>
+#include <toml++/toml.h>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -215,7 +216,18 @@ TEST_CASE("scene: every shipped scene parses", "[scene]") {
     ++count;
     const Scene s = load_scene(entry.path().string());
     CHECK(!s.job.empty());
-    if (s.explicit_structure) CHECK(read_scene_structure(entry.path().string()).dofs() > 0);
+    if (s.explicit_structure) {
+      // As many degrees of freedom and gap springs as the file's mass rows and spring entries
+      // (read here with toml++ on its own).
+      const toml::table file = toml::parse_file(entry.path().string());
+      const GapStructure structure = read_scene_structure(entry.path().string());
+      REQUIRE(file["structure"]["mass"].as_array() != nullptr);
+      REQUIRE(file["structure"]["spring"].as_array() != nullptr);
+      CHECK(structure.dofs() ==
+            static_cast<pwl::Index>(file["structure"]["mass"].as_array()->size()));
+      CHECK(structure.spring_count() ==
+            static_cast<pwl::Index>(file["structure"]["spring"].as_array()->size()));
+    }
   }
   CHECK(count >= 6);
 }

@@ -6,7 +6,7 @@
 
 namespace pwl::analysis {
 
-void run_grid(const std::vector<GridTask>& tasks, const PointChain& chain_of,
+void run_grid(const std::vector<GridTask>& tasks, const PointCaseOf& case_of,
               const Vector& initial_state, const PointSettings& settings,
               const std::map<long, PointResult>& done, const PointSink& sink, const GridRun& run) {
   std::exception_ptr failure;
@@ -28,7 +28,7 @@ void run_grid(const std::vector<GridTask>& tasks, const PointChain& chain_of,
         if (found != done.end()) {
           result = &found->second;
         } else {
-          computed = evaluate_point(chain_of(id), task.continuation ? state : initial_state,
+          computed = evaluate_point(case_of(id), task.continuation ? state : initial_state,
                                     settings);
           result = &computed;
           // An exception must not leave a critical construct: catch it inside, throw outside.

@@ -6,24 +6,18 @@
 #include <cstdio>
 
 #include "pwl/errors.hpp"
+#include "pwl/study/indicators.hpp"
 
 namespace pwl::analysis {
 
-namespace {
-
-std::string doubles(const std::vector<double>& v) {
-  std::string s;
-  for (std::size_t i = 0; i < v.size(); ++i) s += fmt::format("{}{:.17g}", i ? "," : "", v[i]);
-  return s;
-}
-
-std::string number(double v) { return std::isnan(v) ? std::string() : fmt::format("{:.17g}", v); }
-
-}  // namespace
 
 std::string component_name(int component, int masses) {
   return component < masses ? fmt::format("x{}", component + 1)
                             : fmt::format("v{}", component - masses + 1);
+}
+
+PointModel SweepOptions::model() const {
+  return structure ? PointModel(*structure) : PointModel(chain);
 }
 
 bool SweepOptions::is_valid(std::string* why) const {
@@ -47,24 +41,30 @@ bool SweepOptions::is_valid(std::string* why) const {
     *why = "a continuation needs the upward or the downward branch (or both)";
     return false;
   }
-  if (!point.is_valid(chain.masses, why)) return false;
-  if (initial_state.size() != 0 && initial_state.size() != 2 * chain.masses) {
+  const PointModel m = model();
+  if (!point.is_valid(m.dofs(), why)) return false;
+  if (initial_state.size() != 0 && initial_state.size() != 2 * m.dofs()) {
     *why = fmt::format("initial state has {} entries, expected {}", initial_state.size(),
-                       2 * chain.masses);
+                       2 * m.dofs());
     return false;
   }
-  // Every value must give a valid chain (θ > 0, α >= 0, ...): check the two ends.
-  for (double v : {from, to}) {
-    try {
-      make_chain(with_parameter(chain, parameter, v));
-    } catch (const InputError& e) {
-      *why = fmt::format("{} = {}: {}", parameter_name(parameter), v, e.what());
-      return false;
-    }
-    if (parameter == SweepParameter::theta && !(v > 0.0)) {
-      *why = fmt::format("theta = {} must be positive", v);
-      return false;
-    }
+  // Every value must give a valid case (θ > 0, α >= 0, a gap spring's stiffness >= 0, loads with a
+  // common period, ...). The chain's checks are cheap but its range is monotone in each parameter,
+  // so its two ends decide; an explicit structure's loads may lose their common period anywhere
+  // in between, so every value is checked.
+  if (!m.has(parameter, why)) return false;
+  std::vector<double> checked{from, to};
+  if (m.explicit_structure()) {
+    for (int i = 1; i + 1 < points; ++i) checked.push_back(value(i));
+  }
+  for (double v : checked) {
+    if (!m.accepts(parameter, v, why)) return false;
+  }
+  std::string reason;
+  const PointCase base = m.with(parameter, from).point_case();
+  if (!point.method_for(base.period).is_valid(base.structure, &reason)) {
+    *why = fmt::format("method {}: {}", method_label(point.method), reason);
+    return false;
   }
   return true;
 }
@@ -93,36 +93,34 @@ std::vector<GridTask> SweepOptions::tasks() const {
   return result;
 }
 
+PointCase SweepOptions::case_of(long id) const {
+  return model().with(parameter, value(static_cast<int>(id % points))).point_case();
+}
+
 NondimensionalChain SweepOptions::chain_of(long id) const {
+  if (structure) throw InputError("a sweep of an explicit structure has no chain");
   return with_parameter(chain, parameter, value(static_cast<int>(id % points)));
 }
 
 Vector SweepOptions::start_state() const {
-  return initial_state.size() != 0 ? initial_state : Vector::Zero(2 * chain.masses);
+  return initial_state.size() != 0 ? initial_state : Vector::Zero(2 * model().dofs());
 }
 
 std::string SweepOptions::describe() const {
   std::string s;
   s += "study = sweep\n";
-  s += fmt::format("masses = {}\nalpha = {}\nzeta = {:.17g}\ngap = {}\ntheta = {:.17g}\n"
-                   "amplitude = {}\n",
-                   chain.masses, doubles(chain.alpha), chain.zeta, doubles(chain.gap), chain.theta,
-                   doubles(chain.amplitude));
+  s += model().describe();
   s += fmt::format("parameter = {}\nfrom = {:.17g}\nto = {:.17g}\npoints = {}\n",
                    parameter_name(parameter), from, to, points);
   s += fmt::format("mode = {}\n", mode == SweepMode::independent ? "independent" : "continuation");
   if (mode == SweepMode::continuation) {
     s += fmt::format("upward = {}\ndownward = {}\n", upward, downward);
   }
-  std::vector<double> start(static_cast<std::size_t>(start_state().size()));
-  for (std::size_t i = 0; i < start.size(); ++i) start[i] = start_state()[static_cast<Index>(i)];
-  s += fmt::format("initial_state = {}\n", doubles(start));
-  s += fmt::format("transient_periods = {}\nrecorded_periods = {}\nsteps_per_period = {}\n",
-                   point.transient_periods, point.recorded_periods, point.steps_per_period);
-  s += fmt::format("components = {}\nobservable = {}\nlyapunov = {}\nmethod = {}\n",
-                   fmt::join(point.components, ","), point.observable, point.lyapunov,
-                   point.method);
-  if (point.method != "pim") s += fmt::format("tolerance = {:.17g}\n", point.tolerance);
+  const Vector start = start_state();
+  s += "initial_state = ";
+  for (Index i = 0; i < start.size(); ++i) s += fmt::format("{}{:.17g}", i ? "," : "", start[i]);
+  s += "\n";
+  s += point.describe();
   return s;
 }
 
@@ -138,18 +136,17 @@ void write_sweep_files(const SweepOptions& o, const std::map<long, PointResult>&
     throw Error(fmt::format("cannot write {} and {}", poincare_path, classes_path));
   }
   const std::string name = parameter_name(o.parameter);
+  const int dofs = o.model().dofs();
   fmt::print(poincare, "{},direction,index,period_index", name);
-  for (int c : o.point.components) fmt::print(poincare, ",{}", component_name(c, o.chain.masses));
+  for (int c : o.point.components) fmt::print(poincare, ",{}", component_name(c, dofs));
   fmt::print(poincare, "\n");
-  fmt::print(classes, "index,{},direction,regime,code,period,lambda1,lambda1_error,K\n", name);
+  fmt::print(classes, "index,{},direction,{}\n", name, indicator_header());
   // std::map iterates in id order: up (0..N-1) then down (N..2N-1), each by index.
   for (const auto& [id, r] : records) {
     const int index = static_cast<int>(id % o.points);
     const char* direction = id < o.points ? "up" : "down";
     const double value = o.value(index);
-    fmt::print(classes, "{},{:.17g},{},{},{},{},{},{},{}\n", index, value, direction,
-               r.regime.empty() ? "failed" : r.regime, regime_code(r.regime, r.period), r.period,
-               number(r.lambda1), number(r.lambda1_error), number(r.K));
+    fmt::print(classes, "{},{:.17g},{},{}\n", index, value, direction, indicator_cells(r));
     const int rows = r.rows();
     for (int k = 0; k < rows; ++k) {
       fmt::print(poincare, "{:.17g},{},{},{}", value, direction, index,

@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "pwl/errors.hpp"
+#include "pwl/study/indicators.hpp"
 
 namespace pwl::analysis {
 
@@ -16,10 +17,14 @@ double MapAxis::value(int index) const {
 
 namespace {
 
-SweepOptions as_sweep(const NondimensionalChain& chain, const MapAxis& axis,
-                      const PointSettings& point, const Vector& initial_state) {
+SweepOptions as_sweep(const PointModel& model, const MapAxis& axis, const PointSettings& point,
+                      const Vector& initial_state) {
   SweepOptions s;
-  s.chain = chain;
+  if (model.explicit_structure()) {
+    s.structure = model.structure();
+  } else {
+    s.chain = model.chain();
+  }
   s.parameter = axis.parameter;
   s.from = axis.from;
   s.to = axis.to;
@@ -30,9 +35,11 @@ SweepOptions as_sweep(const NondimensionalChain& chain, const MapAxis& axis,
   return s;
 }
 
-std::string number(double v) { return std::isnan(v) ? std::string() : fmt::format("{:.17g}", v); }
-
 }  // namespace
+
+PointModel RegimeMapOptions::model() const {
+  return structure ? PointModel(*structure) : PointModel(chain);
+}
 
 bool RegimeMapOptions::is_valid(std::string* why) const {
   std::string scratch;
@@ -42,12 +49,13 @@ bool RegimeMapOptions::is_valid(std::string* why) const {
                        parameter_name(first.parameter));
     return false;
   }
+  const PointModel base = model();
   for (const MapAxis* axis : {&first, &second}) {
     // Each axis alone, at the other axis's ends.
     const MapAxis& other = axis == &first ? second : first;
+    if (!base.has(other.parameter, why)) return false;
     for (double v : {other.from, other.to}) {
-      const SweepOptions s =
-          as_sweep(with_parameter(chain, other.parameter, v), *axis, point, initial_state);
+      const SweepOptions s = as_sweep(base.with(other.parameter, v), *axis, point, initial_state);
       std::string reason;
       if (!s.is_valid(&reason)) {
         *why = fmt::format("{} axis: {}", axis == &first ? "first" : "second", reason);
@@ -72,7 +80,17 @@ std::vector<GridTask> RegimeMapOptions::tasks() const {
   return result;
 }
 
+PointCase RegimeMapOptions::case_of(long id) const {
+  const int i = static_cast<int>(id % first.points);
+  const int j = static_cast<int>(id / first.points);
+  return model()
+      .with(second.parameter, second.value(j))
+      .with(first.parameter, first.value(i))
+      .point_case();
+}
+
 NondimensionalChain RegimeMapOptions::chain_of(long id) const {
+  if (structure) throw InputError("a map of an explicit structure has no chain");
   const int i = static_cast<int>(id % first.points);
   const int j = static_cast<int>(id / first.points);
   return with_parameter(with_parameter(chain, second.parameter, second.value(j)), first.parameter,
@@ -80,11 +98,11 @@ NondimensionalChain RegimeMapOptions::chain_of(long id) const {
 }
 
 Vector RegimeMapOptions::start_state() const {
-  return initial_state.size() != 0 ? initial_state : Vector::Zero(2 * chain.masses);
+  return initial_state.size() != 0 ? initial_state : Vector::Zero(2 * model().dofs());
 }
 
 std::string RegimeMapOptions::describe() const {
-  SweepOptions s = as_sweep(chain, first, point, initial_state);
+  SweepOptions s = as_sweep(model(), first, point, initial_state);
   s.mode = mode;
   s.upward = true;
   s.downward = false;
@@ -101,15 +119,13 @@ void write_map_file(const RegimeMapOptions& o, const std::map<long, PointResult>
   const std::string path = folder + "/map.csv";
   std::FILE* f = std::fopen(path.c_str(), "w");
   if (f == nullptr) throw Error(fmt::format("cannot write {}", path));
-  fmt::print(f, "i,j,{},{},regime,code,period,lambda1,lambda1_error,K\n",
-             parameter_name(o.first.parameter), parameter_name(o.second.parameter));
+  fmt::print(f, "i,j,{},{},{}\n", parameter_name(o.first.parameter),
+             parameter_name(o.second.parameter), indicator_header());
   for (const auto& [id, r] : records) {
     const int i = static_cast<int>(id % o.first.points);
     const int j = static_cast<int>(id / o.first.points);
-    fmt::print(f, "{},{},{:.17g},{:.17g},{},{},{},{},{},{}\n", i, j, o.first.value(i),
-               o.second.value(j), r.regime.empty() ? "failed" : r.regime,
-               regime_code(r.regime, r.period), r.period, number(r.lambda1),
-               number(r.lambda1_error), number(r.K));
+    fmt::print(f, "{},{},{:.17g},{:.17g},{}\n", i, j, o.first.value(i), o.second.value(j),
+               indicator_cells(r));
   }
   if (std::fclose(f) != 0) throw Error(fmt::format("cannot finish writing {}", path));
 }

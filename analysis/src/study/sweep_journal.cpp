@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "pwl/errors.hpp"
+#include "pwl/study/indicators.hpp"
 
 namespace pwl::analysis {
 namespace {
@@ -72,11 +73,9 @@ class Tokens {
 }  // namespace
 
 std::string encode_record(long id, const PointResult& r) {
-  std::string payload = r.regime.empty() ? std::string("-") : r.regime;
-  fmt::format_to(std::back_inserter(payload), " {}", r.period);
-  put(payload, r.lambda1);
-  put(payload, r.lambda1_error);
-  put(payload, r.K);
+  // The indicators in the table's order (their tokens are blank-free), then the Poincaré points and
+  // the final state.
+  std::string payload = indicator_tokens(r).substr(1);
   fmt::format_to(std::back_inserter(payload), " {} {}", r.columns, r.poincare.size());
   for (double v : r.poincare) put(payload, v);
   fmt::format_to(std::back_inserter(payload), " {}", r.final_state.size());
@@ -99,16 +98,16 @@ std::optional<std::pair<long, PointResult>> decode_record(std::string_view line)
   }
   Tokens t(payload);
   PointResult r;
-  std::string_view regime;
-  long period = 0, columns = 0, count = 0, state = 0;
-  if (!t.next(&regime) || !t.integer(&period) || !t.number(&r.lambda1) ||
-      !t.number(&r.lambda1_error) || !t.number(&r.K) || !t.integer(&columns) ||
-      !t.integer(&count) || columns < 0 || count < 0 || (columns == 0 && count != 0) ||
-      (columns > 0 && count % columns != 0)) {
+  for (const Indicator& indicator : indicators()) {
+    if (indicator.derived) continue;
+    std::string_view token;
+    if (!t.next(&token) || !read_indicator_token(indicator, token, r)) return std::nullopt;
+  }
+  long columns = 0, count = 0, state = 0;
+  if (!t.integer(&columns) || !t.integer(&count) || columns < 0 || count < 0 ||
+      (columns == 0 && count != 0) || (columns > 0 && count % columns != 0)) {
     return std::nullopt;
   }
-  r.regime = regime == "-" ? std::string() : std::string(regime);
-  r.period = static_cast<int>(period);
   r.columns = static_cast<int>(columns);
   r.poincare.resize(static_cast<std::size_t>(count));
   for (double& v : r.poincare)

@@ -1,57 +1,46 @@
 #include "pwl/study/sweep_point.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <cmath>
 #include <memory>
 
 #include "pwl/analysis/lyapunov.hpp"
-#include "pwl/analysis/motion_classifier.hpp"
 #include "pwl/analysis/zero_one_test.hpp"
 #include "pwl/errors.hpp"
-#include "pwl/integrators/pim_integrator.hpp"
-#include "pwl/integrators/reference_integrator.hpp"
 
 namespace pwl::analysis {
 
-std::string parameter_name(SweepParameter parameter) {
-  switch (parameter) {
-    case SweepParameter::theta: return "theta";
-    case SweepParameter::alpha: return "alpha";
-    case SweepParameter::zeta: return "zeta";
-    case SweepParameter::gap: return "gap";
-    case SweepParameter::amplitude: return "amplitude";
+std::string lyapunov_estimate_name(LyapunovEstimate estimate) {
+  switch (estimate) {
+    case LyapunovEstimate::tangent_vector: return "tangent-vector";
+    case LyapunovEstimate::tangent_frame: return "tangent-frame";
+    case LyapunovEstimate::two_trajectories: return "two-trajectories";
   }
-  return "theta";
+  return "tangent-vector";
 }
 
-SweepParameter parse_sweep_parameter(const std::string& name) {
-  if (name == "theta") return SweepParameter::theta;
-  if (name == "alpha") return SweepParameter::alpha;
-  if (name == "zeta") return SweepParameter::zeta;
-  if (name == "gap" || name == "delta") return SweepParameter::gap;
-  if (name == "amplitude") return SweepParameter::amplitude;
+LyapunovEstimate parse_lyapunov_estimate(const std::string& name) {
+  for (LyapunovEstimate e : {LyapunovEstimate::tangent_vector, LyapunovEstimate::tangent_frame,
+                             LyapunovEstimate::two_trajectories}) {
+    if (lyapunov_estimate_name(e) == name) return e;
+  }
   throw InputError(fmt::format(
-      "parameter = \"{}\" is not known; use theta, alpha, zeta, gap (or delta) or amplitude", name));
+      "lyapunov = \"{}\" is not known; use tangent-vector, tangent-frame or two-trajectories",
+      name));
 }
 
-NondimensionalChain with_parameter(const NondimensionalChain& base, SweepParameter parameter,
-                                   double value) {
-  NondimensionalChain c = base;
-  switch (parameter) {
-    case SweepParameter::theta: c.theta = value; break;
-    case SweepParameter::alpha: c.alpha = {value}; break;
-    case SweepParameter::zeta: c.zeta = value; break;
-    case SweepParameter::gap: c.gap = {value}; break;
-    case SweepParameter::amplitude:
-      for (double& q : c.amplitude) q *= value;
-      break;
-  }
-  return c;
+MethodSettings PointSettings::method_for(double period) const {
+  MethodSettings m = method;
+  const MethodTraits& row = method_traits(m.method);
+  if (row.fixed_grid) m.step = period / steps_per_period;
+  if (row.adaptive) m.max_step = period / 8;
+  return m;
 }
 
-bool PointSettings::is_valid(int masses, std::string* why) const {
+bool PointSettings::is_valid(int dofs, std::string* why) const {
   std::string scratch;
   if (why == nullptr) why = &scratch;
   if (transient_periods < 0) {
@@ -62,30 +51,45 @@ bool PointSettings::is_valid(int masses, std::string* why) const {
     *why = fmt::format("recorded periods = {} must be >= 1", recorded_periods);
     return false;
   }
-  if (steps_per_period < 1) {
-    *why = fmt::format("steps per period = {} must be >= 1", steps_per_period);
+  const MethodTraits& row = method_traits(method.method);
+  if (row.fixed_grid && steps_per_period < 1) {
+    *why = fmt::format("steps per period = {} must be >= 1 ({} steps on a fixed grid)",
+                       steps_per_period, row.name);
     return false;
   }
   for (int c : components) {
-    if (c < 0 || c >= 2 * masses) {
+    if (c < 0 || c >= 2 * dofs) {
       *why = fmt::format("component {} is out of range: the state has {} components (0..{})", c,
-                         2 * masses, 2 * masses - 1);
+                         2 * dofs, 2 * dofs - 1);
       return false;
     }
   }
-  if (observable < -1 || observable >= 2 * masses) {
-    *why = fmt::format("observable = {} is out of range (-1 or 0..{})", observable, 2 * masses - 1);
+  if (observable < -1 || observable >= 2 * dofs) {
+    *why = fmt::format("observable = {} is out of range (-1 or 0..{})", observable, 2 * dofs - 1);
     return false;
   }
-  if (method != "pim" && method != "dopri5") {
-    *why = fmt::format("method = \"{}\" must be \"pim\" or \"dopri5\"", method);
+  if (row.adaptive && (!(method.tolerance > 0.0) || !std::isfinite(method.tolerance))) {
+    *why = fmt::format("tolerance = {} of {} must be positive and finite", method.tolerance,
+                       row.name);
     return false;
   }
-  if (!(tolerance > 0.0) || !std::isfinite(tolerance)) {
-    *why = fmt::format("tolerance = {} must be positive", tolerance);
+  if (method.banded_above < 0) {
+    *why = fmt::format("banded_above = {} must be >= 0", method.banded_above);
     return false;
   }
   return true;
+}
+
+std::string PointSettings::describe() const {
+  const MethodTraits& row = method_traits(method.method);
+  std::string s = fmt::format(
+      "transient_periods = {}\nrecorded_periods = {}\nsteps_per_period = {}\n"
+      "components = {}\nobservable = {}\nlyapunov = {}\nlyapunov_estimate = {}\nmethod = {}\n",
+      transient_periods, recorded_periods, steps_per_period, fmt::join(components, ","),
+      observable, lyapunov, lyapunov_estimate_name(lyapunov_estimate), method_label(method));
+  if (row.lcp) s += fmt::format("lcp = {}\n", lcp_algorithm_name(method.lcp));
+  if (row.chooses_form) s += fmt::format("banded_above = {}\n", method.banded_above);
+  return s;
 }
 
 int regime_code(const std::string& regime, int period) {
@@ -109,59 +113,106 @@ Matrix initial_tangent(Index size) {
   return y;
 }
 
+// The averaging of λ1 over `count` periods: the first min(50, recorded/5) align the tangent
+// vector, frame or separation; the rest are averaged in up to 10 blocks.
+struct Averaging {
+  long transient = 0;
+  long iterations = 0;
+  int blocks = 0;
+  bool enough() const { return blocks >= 2; }
+};
+
+Averaging averaging(long count, int recorded) {
+  Averaging a;
+  a.transient = std::min(50, recorded / 5);
+  a.iterations = count - a.transient;
+  a.blocks = static_cast<int>(std::min<long>(10, a.iterations));
+  return a;
+}
+
+// λ1 by two nearby trajectories of the period map from the first recorded point (the loads are
+// T-periodic, so every period starts at t = 0). A blow-up of the companion leaves λ1 unknown.
+void two_trajectory_lyapunov(const PointCase& point, const MethodSettings& method,
+                             const std::vector<Vector>& points, int recorded, PointResult& result) {
+  const Averaging a = averaging(recorded, recorded);
+  if (!a.enough() || points.empty()) return;
+  const Index n = point.structure.dofs();
+  auto shadow = make_integrator(point.structure, method);
+  const StateMap map = [&](const Vector& s) {
+    shadow->set_state(0.0, s.head(n), s.tail(n));
+    shadow->advance_to(point.period);
+    Vector image(2 * n);
+    image << shadow->position(), shadow->velocity();
+    return image;
+  };
+  TwoTrajectoryOptions l;
+  l.transient = a.transient;
+  l.iterations = a.iterations;
+  l.blocks = a.blocks;
+  l.time_per_iteration = point.period;
+  l.separation = 1e-7;
+  try {
+    const LyapunovResult lyapunov = largest_lyapunov_two_trajectories(map, points.front(), l);
+    result.lambda1 = lyapunov.largest();
+    result.lambda1_error = lyapunov.error[0];
+  } catch (const DivergenceError&) {
+  } catch (const LcpError&) {
+  }
+}
+
 }  // namespace
 
-PointResult evaluate_point(const NondimensionalChain& chain, const Vector& initial_state,
-                           const PointSettings& s) {
-  std::string why;
-  if (!s.is_valid(chain.masses, &why)) throw InputError("sweep point: " + why);
-  const GapStructure structure = make_chain(chain);
+PointResult evaluate_point(const PointCase& point, const Vector& initial_state,
+                           const PointSettings& s, PointObserver* observer) {
+  const GapStructure& structure = point.structure;
   const Index n = structure.dofs();
+  std::string why;
+  if (!s.is_valid(static_cast<int>(n), &why)) throw InputError("sweep point: " + why);
   if (initial_state.size() != 2 * n || !initial_state.allFinite()) {
     throw InputError(fmt::format("sweep point: the initial state has {} entries (finite: {}); "
                                  "expected {} finite ones",
                                  initial_state.size(), initial_state.allFinite(), 2 * n));
   }
-  const double period = chain.period();
-  std::unique_ptr<Integrator> integrator;
-  const bool pim = s.method == "pim";
-  if (pim) {
-    PimOptions p;
-    p.step = period / s.steps_per_period;
-    integrator = make_pim_integrator(structure, p);
-  } else {
-    ReferenceOptions r;
-    r.method = RungeKuttaMethod::dopri5;
-    r.relative_tolerance = r.absolute_tolerance = s.tolerance;
-    r.locate_kinks = true;
-    r.max_step = period / 8;
-    integrator = make_reference_integrator(structure, r);
-  }
+  const double period = point.period;
+  const MethodSettings method = s.method_for(period);
+  std::unique_ptr<Integrator> integrator = make_integrator(structure, method);
   integrator->set_state(0.0, initial_state.head(n), initial_state.tail(n));
+  if (observer != nullptr) observer->started(*integrator, point);
+  const auto steps_of = [&](int k) { return observer ? observer->steps_of_period(k) : nullptr; };
 
   PointResult result;
   result.columns = static_cast<int>(s.components.size());
   result.poincare.reserve(static_cast<std::size_t>(s.recorded_periods) * s.components.size());
   std::vector<Vector> points;
   points.reserve(static_cast<std::size_t>(s.recorded_periods));
-  const bool with_lyapunov = pim && s.lyapunov && s.recorded_periods >= 10;
-  Matrix tangent = initial_tangent(2 * n);
-  std::vector<Matrix> growth;  // |J y| per period, as 1x1 Jacobians of the renormalised vector
+  // What the integrator can do decides which estimates are possible, never its name.
+  const bool lyapunov = s.lyapunov && s.recorded_periods >= 10;
+  const bool tangent = lyapunov && integrator->has_tangent_map() &&
+                       s.lyapunov_estimate != LyapunovEstimate::two_trajectories;
+  const bool frame = tangent && s.lyapunov_estimate == LyapunovEstimate::tangent_frame;
+  Matrix tangent_vector = initial_tangent(2 * n);
+  // Per period: |J y| of the renormalised vector as a 1x1 Jacobian, or the whole Jacobian J.
+  std::vector<Matrix> jacobians;
   try {
-    for (int k = 1; k <= s.transient_periods; ++k) integrator->advance_to(k * period);
+    for (int k = 1; k <= s.transient_periods; ++k) integrator->advance_to(k * period, steps_of(k));
     const int total = s.transient_periods + s.recorded_periods;
     for (int k = s.transient_periods + 1; k <= total; ++k) {
-      if (with_lyapunov) {
-        integrator->advance_with_tangent(k * period, tangent);
-        const double norm = tangent.norm();
-        growth.push_back(Matrix::Constant(1, 1, norm));
-        if (norm > 0.0 && std::isfinite(norm)) tangent /= norm;
+      if (frame) {
+        Matrix jacobian = Matrix::Identity(2 * n, 2 * n);
+        integrator->advance_with_tangent(k * period, jacobian, steps_of(k));
+        jacobians.push_back(std::move(jacobian));
+      } else if (tangent) {
+        integrator->advance_with_tangent(k * period, tangent_vector, steps_of(k));
+        const double norm = tangent_vector.norm();
+        jacobians.push_back(Matrix::Constant(1, 1, norm));
+        if (norm > 0.0 && std::isfinite(norm)) tangent_vector /= norm;
       } else {
-        integrator->advance_to(k * period);
+        integrator->advance_to(k * period, steps_of(k));
       }
       Vector state(2 * n);
       state << integrator->position(), integrator->velocity();
       for (int c : s.components) result.poincare.push_back(state[c]);
+      if (observer != nullptr) observer->poincare_point(k, integrator->time(), state);
       points.push_back(std::move(state));
     }
   } catch (const DivergenceError&) {
@@ -174,20 +225,26 @@ PointResult evaluate_point(const NondimensionalChain& chain, const Vector& initi
   result.final_state = points.back();
 
   MotionEvidence evidence;
-  if (with_lyapunov) {
+  if (tangent) {
     LyapunovOptions l;
-    l.transient = std::min(50, s.recorded_periods / 5);
-    l.iterations = static_cast<long>(growth.size()) - l.transient;
-    l.blocks = static_cast<int>(std::min<long>(10, l.iterations));
-    if (l.blocks >= 2) {
-      const LyapunovResult lyapunov = lyapunov_spectrum(growth, l);
-      if (std::isfinite(lyapunov.largest()) && std::isfinite(lyapunov.error[0])) {
-        result.lambda1 = lyapunov.largest();
-        result.lambda1_error = lyapunov.error[0];
-        evidence.lyapunov = result.lambda1;
-        evidence.lyapunov_error = result.lambda1_error;
-      }
+    const Averaging a = averaging(static_cast<long>(jacobians.size()), s.recorded_periods);
+    l.transient = a.transient;
+    l.iterations = a.iterations;
+    l.blocks = a.blocks;
+    l.time_per_iteration = period;
+    if (a.enough()) {
+      const LyapunovResult spectrum = lyapunov_spectrum(jacobians, l);
+      result.lambda1 = spectrum.largest();
+      result.lambda1_error = spectrum.error[0];
     }
+  } else if (lyapunov && s.lyapunov_estimate == LyapunovEstimate::two_trajectories) {
+    two_trajectory_lyapunov(point, method, points, s.recorded_periods, result);
+  }
+  if (std::isfinite(result.lambda1) && std::isfinite(result.lambda1_error)) {
+    evidence.lyapunov = result.lambda1;
+    evidence.lyapunov_error = result.lambda1_error;
+  } else {
+    result.lambda1 = result.lambda1_error = std::numeric_limits<double>::quiet_NaN();
   }
   const int observable = s.observable >= 0 ? s.observable : static_cast<int>(n) - 1;
   ZeroOneOptions zero_one;
@@ -206,6 +263,7 @@ PointResult evaluate_point(const NondimensionalChain& chain, const Vector& initi
   result.regime = c.name();
   result.period = c.regime == Regime::periodic ? c.period : 0;
   if (c.regime == Regime::unbounded || !result.final_state.allFinite()) result.final_state.resize(0);
+  if (observer != nullptr) observer->classified(c, result);
   return result;
 }
 

@@ -27,7 +27,7 @@ struct CaseOptions {
   int skip_periods = 0;  // periods left out of the written output
   int steps_per_period = 200;
   double dt = 0.0;             // overrides steps_per_period; must divide the period
-  std::string method = "pim";  // pim | pim-dense | pim-banded | pim-switching | exact | dopri5 | rkf78
+  std::string method = "pim";  // a name of the method table (method_names())
   double tolerance = 1e-10;
   bool locate_kinks = false;
   std::string lcp_solver = "block-pivoting";

@@ -1,5 +1,6 @@
-// pwl map: a two-parameter regime map of the nondimensional chain, classified cell by cell (see
-// analysis/include/pwl/analysis/regime_map.hpp), with a regime heatmap and a λ1 heatmap.
+// pwl map: a two-parameter regime map of the paper's chain or of an explicit structure, classified
+// cell by cell (see analysis/include/pwl/study/regime_map.hpp), with a regime heatmap and a λ1
+// heatmap.
 #include <fmt/format.h>
 
 #include <memory>
@@ -14,7 +15,7 @@ namespace pwl::app {
 namespace {
 
 struct MapFlags {
-  ChainFlags chain;
+  ModelFlags model;
   PointFlags point;
   RunFlags run;
   std::string x = "theta";
@@ -29,16 +30,21 @@ struct MapFlags {
 
 analysis::RegimeMapOptions map_options(const MapFlags& f) {
   analysis::RegimeMapOptions o;
-  o.chain = f.chain.chain();
-  o.first.parameter = analysis::parse_sweep_parameter(f.x);
+  const analysis::PointModel model = f.model.model();
+  if (model.explicit_structure()) {
+    o.structure = model.structure();
+  } else {
+    o.chain = model.chain();
+  }
+  o.first.parameter = parse_model_parameter(model, "--x", f.x);
   parse_range("--x-range", f.x_range, &o.first.from, &o.first.to);
   o.first.points = f.x_points;
-  o.second.parameter = analysis::parse_sweep_parameter(f.y);
+  o.second.parameter = parse_model_parameter(model, "--y", f.y);
   parse_range("--y-range", f.y_range, &o.second.from, &o.second.to);
   o.second.points = f.y_points;
   o.mode = f.mode == "continuation" ? analysis::SweepMode::continuation
                                     : analysis::SweepMode::independent;
-  o.point = f.point.settings(o.chain.masses);
+  o.point = f.point.settings(model.dofs());
   o.point.components.clear();
   std::string why;
   if (!o.is_valid(&why)) throw InputError(why);
@@ -61,7 +67,7 @@ void map(const MapFlags& f) {
           "data='{0}/map.csv'; out='{0}/regime_map.{6}'; out_lambda='{0}/lambda1_map.{6}'; "
           "xname='{1}'; yname='{2}'; dx={3:.17g}; dy={4:.17g}; subtitle={5}",
           f.run.out, parameter_label(o.first.parameter), parameter_label(o.second.parameter), dx,
-          dy, gnuplot_quoted(study_title(o.chain, o.point)), format);
+          dy, gnuplot_quoted(study_title(o.model(), o.point)), format);
     };
     if (draw_figure(scripts_directory() + "/regime_map.gp", definitions, &why)) {
       fmt::print("wrote {0}/regime_map.png, {0}/lambda1_map.png and their .svg\n", f.run.out);
@@ -81,8 +87,11 @@ void add_map_command(CLI::App& app) {
       "Regime map: classify every cell of a two-parameter grid\n"
       "Example: pwl map --figure 5 --x theta --x-range 0.5:3 --x-points 40 --y alpha \\\n"
       "           --y-range 1:15 --y-points 29 --out theta_alpha");
-  add_chain_flags(*c, flags->chain);
-  c->add_option("--x", flags->x, "Horizontal parameter: theta, alpha, zeta, gap or amplitude");
+  add_model_flags(*c, flags->model);
+  c->add_option("--x", flags->x,
+                "Horizontal parameter: theta, alpha, zeta, gap or amplitude of the chain;\n"
+                "spring<j>.stiffness, spring<j>.gap, load<j>.amplitude, load<j>.frequency or\n"
+                "damping of a --structure-scene");
   c->add_option("--x-range", flags->x_range, "FROM:TO of the horizontal parameter");
   c->add_option("--x-points", flags->x_points, "Values of the horizontal parameter");
   c->add_option("--y", flags->y, "Vertical parameter");

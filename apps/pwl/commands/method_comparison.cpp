@@ -136,12 +136,8 @@ ComparisonResult simulate_with_comparison(const CaseOptions& run, const Comparis
         run.description(), steps, run.skip_periods, run.periods, result.distinct_points,
         result.largest_difference);
   };
-  std::string why;
-  if (!draw_figure(scripts_directory() + "/comparison.gp", definitions, &why)) {
-    fmt::print(stderr, "pwl simulate: no figure: {}\n", why);
-  } else if (!output.quiet) {
-    fmt::print("wrote {}/comparison.png and .svg\n", out);
-  }
+  draw_figure_and_report(scripts_directory() + "/comparison.gp", definitions,
+                         out + "/comparison", "pwl simulate", output.quiet);
   return result;
 }
 

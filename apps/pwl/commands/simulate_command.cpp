@@ -91,12 +91,8 @@ void simulate(const SimulateOptions& options) {
           integrator->name(), run.description(), run.periods - run.skip_periods, run.skip_periods,
           format, gnuplot_quoted(output.title));
     };
-    std::string why;
-    if (!draw_figure(scripts_directory() + "/phase_portrait.gp", definitions, &why)) {
-      fmt::print(stderr, "pwl simulate: no figure: {}\n", why);
-    } else if (!output.quiet) {
-      fmt::print("wrote {}/phase.png and .svg\n", output.out);
-    }
+    draw_figure_and_report(scripts_directory() + "/phase_portrait.gp", definitions,
+                           output.out + "/phase", "pwl simulate", output.quiet);
   }
 }
 

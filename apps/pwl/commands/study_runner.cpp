@@ -15,6 +15,7 @@
 #include "commands/case_options.hpp"
 #include "parallel/distributed.hpp"
 #include "output/progress_bar.hpp"
+#include "pwl/integrators/method_table.hpp"
 #include "pwl/study/parameter_sweep.hpp"
 #include "pwl/study/sweep_journal.hpp"
 #include "pwl/errors.hpp"
@@ -23,8 +24,8 @@ namespace pwl::app {
 
 namespace fs = std::filesystem;
 
-NondimensionalChain ChainFlags::chain() const {
-  // The same chain flags as simulate and analyze, built the same way.
+analysis::PointModel ModelFlags::model() const {
+  // The same model flags as simulate and analyze, built and checked the same way.
   CaseOptions c;
   c.figure = figure;
   c.masses = masses;
@@ -33,11 +34,28 @@ NondimensionalChain ChainFlags::chain() const {
   c.gap = gap;
   c.theta = theta;
   c.loads = loads;
-  return c.chain();
+  c.structure_scene = structure_scene;
+  if (!c.explicit_structure()) return analysis::PointModel(c.chain());
+  return analysis::PointModel(analysis::ExplicitStructure{
+      c.structure(), c.description(), fs::path(structure_scene).filename().string()});
 }
 
-void add_chain_flags(CLI::App& c, ChainFlags& f) {
+void add_model_flags(CLI::App& c, ModelFlags& f) {
   add_chain_options(c, f.figure, f.masses, f.alpha, f.zeta, f.gap, f.theta, f.loads);
+  c.add_option("--structure-scene", f.structure_scene,
+               "Vary the explicit structure (M, C, K, gap springs, loads) of this scene file's\n"
+               "[structure] table instead of the chain; its parameters are spring<j>.stiffness,\n"
+               "spring<j>.gap, load<j>.amplitude, load<j>.frequency and damping (a scale of C)")
+      ->check(CLI::ExistingFile);
+}
+
+analysis::SweepParameter parse_model_parameter(const analysis::PointModel& model,
+                                               const std::string& flag, const std::string& name) {
+  try {
+    return model.parameter(name);
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{} {}: {}", flag, name, e.what()));
+  }
 }
 
 analysis::PointSettings PointFlags::settings(int masses) const {
@@ -46,6 +64,11 @@ analysis::PointSettings PointFlags::settings(int masses) const {
   s.recorded_periods = periods;
   s.steps_per_period = steps_per_period;
   s.lyapunov = !no_lyapunov;
+  s.lyapunov_estimate = analysis::parse_lyapunov_estimate(lyapunov);
+  s.method.method = parse_method(method);
+  s.method.tolerance = tolerance;
+  s.method.locate_kinks = locate_kinks;
+  s.method.lcp = parse_lcp_algorithm(lcp_solver);
   for (const std::string& name : record) {
     int component = -1;
     if (name.size() >= 2 && (name[0] == 'x' || name[0] == 'v')) {
@@ -78,6 +101,17 @@ void add_point_flags(CLI::App& c, PointFlags& f, bool with_record) {
         ->delimiter(',');
   }
   c.add_flag("--no-lyapunov", f.no_lyapunov, "Skip λ1 (then only the period search and K decide)");
+  c.add_option("--lyapunov", f.lyapunov,
+               "How λ1 is estimated: tangent-vector, tangent-frame (both need a method with an\n"
+               "exact tangent map; without one λ1 is left out) or two-trajectories (any method)")
+      ->check(CLI::IsMember({"tangent-vector", "tangent-frame", "two-trajectories"}));
+  c.add_option("--method", f.method, method_help())->check(CLI::IsMember(method_names()));
+  c.add_option("--tol", f.tolerance, "Relative and absolute tolerance of dopri5/rkf78")
+      ->check(positive_number());
+  c.add_flag("--locate-kinks", f.locate_kinks,
+             "dopri5/rkf78: end a step exactly at every spring opening or closing");
+  c.add_option("--lcp", f.lcp_solver, "PIM's LCP solver: block-pivoting or lemke")
+      ->check(CLI::IsMember({"block-pivoting", "lemke"}));
 }
 
 void add_run_flags(CLI::App& c, RunFlags& f) {
@@ -175,7 +209,7 @@ void run_distributed(const Study& study, const RunFlags& flags, const Distribute
   std::string computed;
   {
     ProgressBar bar(todo, "points", !flags.quiet && world.rank() == 0);
-    analysis::run_grid(mine, study.chain_of, study.initial_state, study.settings, done,
+    analysis::run_grid(mine, study.case_of, study.initial_state, study.settings, done,
                        [&](long id, const analysis::PointResult& r) {
                          journal->append(id, r);
                          if (world.size() > 1) computed += analysis::encode_record(id, r);
@@ -230,29 +264,64 @@ void run_study(const Study& study, const RunFlags& flags) {
   }
 }
 
-std::string parameter_label(analysis::SweepParameter parameter) {
-  switch (parameter) {
-    case analysis::SweepParameter::theta:
+std::string parameter_label(const analysis::SweepParameter& parameter) {
+  using Kind = analysis::SweepParameter::Kind;
+  const int j = parameter.index() + 1;
+  switch (parameter.kind()) {
+    case Kind::theta:
       return "θ = ω/ω_0";
-    case analysis::SweepParameter::alpha:
+    case Kind::alpha:
       return "α = k_2/k_1";
-    case analysis::SweepParameter::zeta:
+    case Kind::zeta:
       return "ζ (damping ratio)";
-    case analysis::SweepParameter::gap:
+    case Kind::gap:
       return "Δ̃ (nondimensional gap)";
-    case analysis::SweepParameter::amplitude:
+    case Kind::amplitude:
       return "load scale (times Q)";
+    case Kind::spring_stiffness:
+      return fmt::format("stiffness k of gap spring {}", j);
+    case Kind::spring_gap:
+      return fmt::format("gap Δ of gap spring {}", j);
+    case Kind::load_amplitude:
+      return fmt::format("amplitude of load {}", j);
+    case Kind::load_frequency:
+      return fmt::format("circular frequency ω of load {}", j);
+    case Kind::damping:
+      return "damping scale (times C)";
   }
   return analysis::parameter_name(parameter);
 }
 
-std::string study_title(const NondimensionalChain& chain, const analysis::PointSettings& point) {
-  return fmt::format(
-      "base case: {} masses, α = {}, ζ = {}, Δ̃ = {}, θ = {}, Q = ({}); {} + {} periods per point, "
-      "η = T/{}",
-      chain.masses, fmt::join(chain.alpha, ","), chain.zeta, fmt::join(chain.gap, ","), chain.theta,
-      fmt::join(chain.amplitude, ","), point.transient_periods, point.recorded_periods,
-      point.steps_per_period);
+std::string study_title(const analysis::PointModel& model, const analysis::PointSettings& point) {
+  const MethodTraits& method = method_traits(point.method.method);
+  // The PIM is the default and goes unnamed; any other method is named by its label.
+  const std::string named =
+      point.method.method == Method::pim ? std::string() : method_label(point.method) + ", ";
+  const std::string integration =
+      method.fixed_grid ? fmt::format("{}η = T/{}", named, point.steps_per_period)
+                        : method_label(point.method);
+  std::string base;
+  if (model.explicit_structure()) {
+    const GapStructure& g = model.structure().structure;
+    // Underscores of the file name escaped: gnuplot's enhanced text reads '_' as a subscript.
+    std::string label;
+    for (char ch : model.structure().label) label += ch == '_' ? std::string("\\_") : std::string(1, ch);
+    const auto count = [](auto k, const char* one, const char* many) {
+      return fmt::format("{} {}", k, k == 1 ? one : many);
+    };
+    base = fmt::format("base case: {}, {}, {}, {}", label, count(g.dofs(), "mass", "masses"),
+                       count(g.springs.size(), "gap spring", "gap springs"),
+                       count(g.loads.size(), "load", "loads"));
+  } else {
+    const NondimensionalChain& chain = model.chain();
+    base = fmt::format("base case: {} masses, α = {}, ζ = {}, Δ̃ = {}, θ = {}, Q = ({})",
+                       chain.masses, fmt::join(chain.alpha, ","), chain.zeta,
+                       fmt::join(chain.gap, ","), chain.theta, fmt::join(chain.amplitude, ","));
+  }
+  std::string title = fmt::format("{}; {} + {} periods per point, {}", base,
+                                  point.transient_periods, point.recorded_periods, integration);
+  title.erase(std::remove(title.begin(), title.end(), '\''), title.end());
+  return title;
 }
 
 }  // namespace pwl::app

@@ -1,6 +1,7 @@
 #pragma once
-// What `pwl sweep` and `pwl map` share: the flags of the base chain and of each point, and the
-// driver that runs a study's points into an output folder so that a long run loses nothing.
+// What `pwl sweep` and `pwl map` share: the flags of the base model (the paper's chain or an
+// explicit structure) and of each point, and the driver that runs a study's points into an output
+// folder so that a long run loses nothing.
 //
 // The folder holds config.txt (every setting that changes a result), one journal-<rank>.log per
 // process (a line per finished point, see sweep_journal.hpp) and, once every point is done, the
@@ -22,8 +23,9 @@
 
 namespace pwl::app {
 
-// The base chain: a paper preset and flags that override it.
-struct ChainFlags {
+// The base model: a paper preset and flags that override it, or an explicit structure from a
+// scene file (--structure-scene; the chain's flags do not apply then).
+struct ModelFlags {
   std::string figure;
   int masses = 5;
   std::vector<double> alpha;
@@ -31,9 +33,16 @@ struct ChainFlags {
   double gap = std::numeric_limits<double>::quiet_NaN();
   double theta = std::numeric_limits<double>::quiet_NaN();
   std::vector<double> loads;
-  NondimensionalChain chain() const;
+  std::string structure_scene;
+  // Throws InputError for chain flags given with a structure scene, or a scene that is not valid.
+  analysis::PointModel model() const;
 };
-void add_chain_flags(CLI::App& command, ChainFlags& flags);
+void add_model_flags(CLI::App& command, ModelFlags& flags);
+
+// The parameter `name` of `model`, for the flag `flag`: InputError naming the flag, the value and
+// the model's parameters otherwise.
+analysis::SweepParameter parse_model_parameter(const analysis::PointModel& model,
+                                               const std::string& flag, const std::string& name);
 
 // How each point is integrated and what it keeps.
 struct PointFlags {
@@ -42,7 +51,13 @@ struct PointFlags {
   int steps_per_period = 200;
   std::vector<std::string> record;  // component names: x1..xn, v1..vn
   bool no_lyapunov = false;
-  analysis::PointSettings settings(int masses) const;  // throws InputError for a bad name
+  std::string lyapunov = "tangent-vector";
+  std::string method = "pim";
+  double tolerance = 1e-10;
+  bool locate_kinks = false;
+  std::string lcp_solver = "block-pivoting";
+  // Throws InputError for a bad name or value.
+  analysis::PointSettings settings(int dofs) const;
 };
 void add_point_flags(CLI::App& command, PointFlags& flags, bool with_record);
 
@@ -59,21 +74,21 @@ void add_run_flags(CLI::App& command, RunFlags& flags);
 struct Study {
   std::string description;  // config.txt
   std::vector<analysis::GridTask> tasks;
-  analysis::PointChain chain_of;
+  analysis::PointCaseOf case_of;
   Vector initial_state;
   analysis::PointSettings settings;
   // Called on rank 0 with every record, in id order, once all are done.
   std::function<void(const std::map<long, analysis::PointResult>&)> finish;
 };
 
-// The study of a sweep or a map: both option types give its description, tasks, chains, start
+// The study of a sweep or a map: both option types give its description, tasks, cases, start
 // state and point settings the same way.
 template <class GridOptions>
 Study study_of(const GridOptions& o) {
   Study study;
   study.description = o.describe();
   study.tasks = o.tasks();
-  study.chain_of = [o](long id) { return o.chain_of(id); };
+  study.case_of = [o](long id) { return o.case_of(id); };
   study.initial_state = o.start_state();
   study.settings = o.point;
   return study;
@@ -85,10 +100,11 @@ void run_study(const Study& study, const RunFlags& flags);
 // Parses a range "a:b" into its ends; throws InputError naming the flag otherwise.
 void parse_range(const std::string& flag, const std::string& text, double* from, double* to);
 
-// Figure text: the axis label of a swept parameter ("θ = ω/ω0"), and a title line stating the
-// base case and the integration ("base case: 5 masses, α = 5, ζ = 0.2, Δ̃ = 0, Q = (1,-1,1,-1,1);
-// 300 + 200 periods per point, η = T/200"). Single quotes are left out (gnuplot strings).
-std::string parameter_label(analysis::SweepParameter parameter);
-std::string study_title(const NondimensionalChain& chain, const analysis::PointSettings& point);
+// Figure text: the axis label of a swept parameter ("θ = ω/ω0", "gap Δ of spring 1"), and a title
+// line stating the base case and the integration ("base case: 5 masses, α = 5, ζ = 0.2, Δ̃ = 0,
+// Q = (1,-1,1,-1,1); 300 + 200 periods per point, η = T/200"). Single quotes are left out (gnuplot
+// strings).
+std::string parameter_label(const analysis::SweepParameter& parameter);
+std::string study_title(const analysis::PointModel& model, const analysis::PointSettings& point);
 
 }  // namespace pwl::app

@@ -1,5 +1,5 @@
-// pwl sweep: a one-parameter sweep of the nondimensional chain, the data and the figure of a
-// bifurcation diagram (see analysis/include/pwl/analysis/parameter_sweep.hpp).
+// pwl sweep: a one-parameter sweep of the paper's chain or of an explicit structure, the data and
+// the figure of a bifurcation diagram (see analysis/include/pwl/study/parameter_sweep.hpp).
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -20,7 +20,7 @@ namespace pwl::app {
 namespace {
 
 struct SweepFlags {
-  ChainFlags chain;
+  ModelFlags model;
   PointFlags point;
   RunFlags run;
   std::string parameter = "theta";
@@ -32,15 +32,20 @@ struct SweepFlags {
 
 analysis::SweepOptions sweep_options(const SweepFlags& f) {
   analysis::SweepOptions o;
-  o.chain = f.chain.chain();
-  o.parameter = analysis::parse_sweep_parameter(f.parameter);
+  const analysis::PointModel model = f.model.model();
+  if (model.explicit_structure()) {
+    o.structure = model.structure();
+  } else {
+    o.chain = model.chain();
+  }
+  o.parameter = parse_model_parameter(model, "--parameter", f.parameter);
   parse_range("--range", f.range, &o.from, &o.to);
   o.points = f.points;
   o.mode = f.mode == "continuation" ? analysis::SweepMode::continuation
                                     : analysis::SweepMode::independent;
   o.upward = f.directions != "down";
   o.downward = f.directions != "up";
-  o.point = f.point.settings(o.chain.masses);
+  o.point = f.point.settings(model.dofs());
   std::string why;
   if (!o.is_valid(&why)) throw InputError(why);
   return o;
@@ -98,11 +103,11 @@ void sweep(const SweepFlags& f) {
           f.run.out, parameter_label(o.parameter),
           o.point.components.empty()
               ? std::string("x")
-              : analysis::component_name(o.point.components[0], o.chain.masses),
+              : analysis::component_name(o.point.components[0], o.model().dofs()),
           gnuplot_quoted(fmt::format(
               "pwl sweep of {} ({}): {}", analysis::parameter_name(o.parameter),
               o.mode == analysis::SweepMode::continuation ? "continuation" : "independent",
-              study_title(o.chain, o.point))),
+              study_title(o.model(), o.point))),
           format);
     };
     if (draw_figure(scripts_directory() + "/bifurcation.gp", definitions, &why)) {
@@ -122,10 +127,14 @@ void add_sweep_command(CLI::App& app) {
       "sweep",
       "Bifurcation diagram: Poincaré points and regimes over one parameter\n"
       "Example: pwl sweep --figure 5 --parameter theta --range 0.5:3 --points 200 \\\n"
-      "           --mode continuation --out theta_sweep");
-  add_chain_flags(*c, flags->chain);
+      "           --mode continuation --out theta_sweep\n"
+      "         pwl sweep --structure-scene apps/scenes/two_mass_stop.toml \\\n"
+      "           --parameter spring1.gap --range 0.05:0.5 --points 50 --out gap_sweep");
+  add_model_flags(*c, flags->model);
   c->add_option("--parameter", flags->parameter,
-                "Parameter swept: theta, alpha, zeta, gap (Δ̃) or amplitude (scales Q)");
+                "Parameter swept: theta, alpha, zeta, gap (Δ̃) or amplitude (scales Q) of the\n"
+                "chain; spring<j>.stiffness, spring<j>.gap, load<j>.amplitude, load<j>.frequency\n"
+                "or damping (scales C) of a --structure-scene (j from 1)");
   c->add_option("--range", flags->range, "FROM:TO, from < to");
   c->add_option("--points", flags->points, "Number of parameter values N");
   c->add_option("--mode", flags->mode,

@@ -53,4 +53,17 @@ bool draw_figure(const std::string& script,
 }
 
 
+bool draw_figure_and_report(
+    const std::string& script,
+    const std::function<std::string(const std::string& format)>& definitions,
+    const std::string& stem, const std::string& who, bool quiet) {
+  std::string why;
+  if (!draw_figure(script, definitions, &why)) {
+    fmt::print(stderr, "{}: no figure: {}\n", who, why);
+    return false;
+  }
+  if (!quiet) fmt::print("wrote {}.png and .svg\n", stem);
+  return true;
+}
+
 }  // namespace pwl::app

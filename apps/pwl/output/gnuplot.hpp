@@ -19,6 +19,14 @@ bool draw_figure(const std::string& script,
                  const std::function<std::string(const std::string& format)>& definitions,
                  std::string* why);
 
+// Draws a figure (draw_figure) whose files are `stem`.png and `stem`.svg, and says what became of
+// it: "wrote <stem>.png and .svg" on standard output (unless quiet), or "<who>: no figure: <why>"
+// on standard error. Returns whether the figure was drawn.
+bool draw_figure_and_report(
+    const std::string& script,
+    const std::function<std::string(const std::string& format)>& definitions,
+    const std::string& stem, const std::string& who, bool quiet);
+
 // `text` as a gnuplot single-quoted string literal ('it''s'), for titles and paths.
 std::string gnuplot_quoted(const std::string& text);
 

@@ -19,7 +19,7 @@ std::optional<fs::path> installed_data_directory() {
   const fs::path bin = self.parent_path();
   if (bin.filename() != fs::path(PWL_INSTALL_BIN_DIR).filename()) return std::nullopt;
   const fs::path data = bin.parent_path() / PWL_INSTALL_DATA_DIR;
-  if (!fs::is_directory(data / "scripts", error)) return std::nullopt;
+  if (!fs::is_directory(data, error)) return std::nullopt;
   return data;
 }
 

@@ -93,18 +93,14 @@ class BandedPimIntegrator final : public Integrator {
   const Vector& velocity() const override { return velocity_; }
 
   void advance_to(double t_end, const StepObserver& observer) override {
-    const double eta = propagator_.step_size();
-    const long count = detail::fixed_step_count(t_end, propagator_.time(), eta);
-    for (long k = 0; k < count; ++k) {
-      propagator_.step();
-      stats_.lcp_pivots += propagator_.last_lcp_pivots();
-      if (observer) {
-        sync();
-        observer(propagator_.time(), position_, velocity_);
-      }
-    }
-    stats_.steps += count;
-    sync();
+    stats_.steps += detail::advance_on_grid(
+        t_end, propagator_.time(), propagator_.step_size(), observer, position_, velocity_,
+        [&] {
+          propagator_.step();
+          stats_.lcp_pivots += propagator_.last_lcp_pivots();
+          return propagator_.time();
+        },
+        [this] { sync(); });
   }
 
   IntegratorStats stats() const override { return stats_; }

@@ -4,14 +4,18 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 
 #include "pwl/errors.hpp"
+#include "pwl/numerics/state_checks.hpp"
 
 namespace pwl {
 
 namespace {
+
+constexpr double kNotFinite = std::numeric_limits<double>::quiet_NaN();
 
 double larger(double largest, double value) {
   const double m = std::abs(value);
@@ -156,13 +160,7 @@ BandedPropagator::BandedPropagator(BandedStepOperators ops, const BandedLcpOptio
 
 void BandedPropagator::set_state(double t, const Eigen::Ref<const Vector>& x,
                                  const Eigen::Ref<const Vector>& v) {
-  if (x.size() != n_ || v.size() != n_) {
-    throw InputError(fmt::format("state has {} displacements and {} velocities, expected {}",
-                                 x.size(), v.size(), n_));
-  }
-  if (!std::isfinite(t) || !x.allFinite() || !v.allFinite()) {
-    throw InputError(fmt::format("initial state at t = {} has a non-finite entry", t));
-  }
+  check_initial_state(t, x, v, n_);
   origin_ = t;
   steps_ = 0;
   for (Index i = 0; i < n_; ++i) {
@@ -251,13 +249,7 @@ void BandedPropagator::step() {
   state_.swap(bar_);
   ++steps_;
   if (!(largest <= bound_)) {
-    if (!state_.allFinite()) {
-      throw DivergenceError(fmt::format("the motion blew up at t = {}: the state is not finite",
-                                        time()));
-    }
-    throw DivergenceError(fmt::format(
-        "the motion blew up at t = {}: largest |x| or |x'| is {} (bound {})", time(), largest,
-        bound_));
+    throw_divergence(time(), state_.allFinite() ? largest : kNotFinite, bound_);
   }
 }
 

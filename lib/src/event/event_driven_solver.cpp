@@ -17,6 +17,7 @@
 
 #include "event/event_location.hpp"
 #include "pwl/errors.hpp"
+#include "pwl/numerics/state_checks.hpp"
 
 namespace pwl {
 
@@ -583,10 +584,7 @@ struct EventDrivenSolver::Impl {
   void check(double time) const {
     const double largest = state.cwiseAbs().maxCoeff();
     if (!(largest <= options.divergence_bound)) {
-      throw DivergenceError(fmt::format(
-          "event-driven solver: the motion blew up at t = {}: largest |x| or |x'| is {} "
-          "(divergence_bound {})",
-          time, largest, options.divergence_bound));
+      throw_divergence(time, largest, options.divergence_bound);
     }
   }
 };
@@ -642,13 +640,7 @@ Index EventDrivenSolver::dofs() const { return impl_->s.n; }
 void EventDrivenSolver::set_state(double t, const Vector& x, const Vector& v) {
   Impl& p = *impl_;
   const Index n = p.s.n;
-  if (x.size() != n || v.size() != n) {
-    throw InputError(fmt::format("set_state: x has size {} and v has size {}; both must be {}",
-                                 x.size(), v.size(), n));
-  }
-  if (!std::isfinite(t) || !x.allFinite() || !v.allFinite()) {
-    throw InputError(fmt::format("set_state: the state at t = {} has a non-finite entry", t));
-  }
+  check_initial_state(t, x, v, n);
   p.t = t;
   p.state.resize(2 * n);
   p.state << x, v;

@@ -30,6 +30,7 @@ SwitchingPimOptions switching_options(const MethodSettings& s) {
   SwitchingPimOptions o;
   o.step = s.step;
   o.lcp_solver = s.lcp;
+  o.force_degree = s.force_degree;
   return o;
 }
 
@@ -44,6 +45,7 @@ std::unique_ptr<Integrator> make_pim_dense(const GapStructure& g, const MethodSe
 std::unique_ptr<Integrator> make_pim_banded(const GapStructure& g, const MethodSettings& s) {
   BandedPimOptions b;
   b.step = s.step;
+  b.band.band = s.band;
   return make_banded_pim_integrator(g, b);
 }
 
@@ -54,6 +56,7 @@ std::unique_ptr<Integrator> make_switching_dense(const GapStructure& g, const Me
 std::unique_ptr<Integrator> make_switching_banded(const GapStructure& g, const MethodSettings& s) {
   BandedSwitchingPimOptions b;
   b.pim = switching_options(s);
+  b.band.band = s.band;
   return make_banded_switching_pim(g, b);
 }
 
@@ -77,32 +80,32 @@ std::unique_ptr<Integrator> make_runge_kutta(const GapStructure& g, const Method
 }
 
 // The one table. Columns: method, name, label, summary, fixed_grid, tangent_map, adaptive,
-// kink_location, lcp, chooses_form, banded, exact, order, max_dofs, max_springs, make. A row that
-// chooses its form states the capabilities of its dense form; the integrator it builds reports the
-// form it took (Integrator::method()).
+// kink_location, locates_switches, lcp, chooses_form, banded, exact, order, max_dofs, max_springs,
+// make. A row that chooses its form states the capabilities of its dense form; the integrator it
+// builds reports the form it took (Integrator::method()).
 constexpr std::array<MethodTraits, 9> kTable{{
     {Method::pim, "pim", "PIM", "the paper's PIM (dense or banded by size)",
-     true, true, false, false, true, true, false, false, 2, 0, 0, make_pim},
+     true, true, false, false, false, true, true, false, false, 2, 0, 0, make_pim},
     {Method::pim_dense, "pim-dense", "dense PIM", "the PIM with dense operators",
-     true, true, false, false, true, false, false, false, 2, 0, 0, make_pim_dense},
+     true, true, false, false, false, true, false, false, false, 2, 0, 0, make_pim_dense},
     {Method::pim_banded, "pim-banded", "banded PIM", "the PIM with banded operators (long chains)",
-     true, false, false, false, false, false, true, false, 2, 0, 0, make_pim_banded},
+     true, false, false, false, false, false, false, true, false, 2, 0, 0, make_pim_banded},
     {Method::pim_switching, "pim-switching", "switching PIM",
      "higher order, located switches (dense or banded by size)",
-     true, false, false, false, true, true, false, false, 5, 0, 0, make_switching},
+     true, false, false, false, true, true, true, false, false, 5, 0, 0, make_switching},
     {Method::pim_switching_dense, "pim-switching-dense", "switching PIM",
      "the switching PIM with dense operators",
-     true, false, false, false, true, false, false, false, 5, 0, 0, make_switching_dense},
+     true, false, false, false, true, true, false, false, false, 5, 0, 0, make_switching_dense},
     {Method::pim_switching_banded, "pim-switching-banded", "banded switching PIM",
      "the switching PIM with banded operators",
-     true, false, false, false, false, false, true, false, 5, 0, 0, make_switching_banded},
+     true, false, false, false, true, false, false, true, false, 5, 0, 0, make_switching_banded},
     {Method::exact, "exact", "exact event-driven", "event-driven, closed form per contact state",
-     false, false, false, false, false, false, false, true, 0, 0, 62, make_exact},
+     false, false, false, false, true, false, false, false, true, 0, 0, 62, make_exact},
     {Method::dopri5, "dopri5", "dopri5", "Dormand-Prince 5(4), with --tol and --locate-kinks",
-     false, false, true, true, false, false, false, false, 5, 0, 0,
+     false, false, true, true, false, false, false, false, false, 5, 0, 0,
      make_runge_kutta<RungeKuttaMethod::dopri5>},
     {Method::rkf78, "rkf78", "rkf78", "Runge-Kutta-Fehlberg 7(8), with --tol and --locate-kinks",
-     false, false, true, true, false, false, false, false, 8, 0, 0,
+     false, false, true, true, false, false, false, false, false, 8, 0, 0,
      make_runge_kutta<RungeKuttaMethod::rkf78>},
 }};
 
@@ -172,7 +175,16 @@ bool MethodSettings::is_valid(const GapStructure& structure, std::string* why) c
     *why = fmt::format("banded_above = {} must be >= 0", banded_above);
     return false;
   }
+  if (band < 0) {
+    *why = fmt::format("band = {} must be >= 0", band);
+    return false;
+  }
   return true;
+}
+
+bool locates_switches(const MethodSettings& s) {
+  const MethodTraits& row = method_traits(s.method);
+  return row.locates_switches || (row.kink_location && s.locate_kinks);
 }
 
 std::unique_ptr<Integrator> make_integrator(const GapStructure& structure,

@@ -16,8 +16,34 @@
 
 #include "pwl/errors.hpp"
 #include "pwl/numerics/substructure_exponential.hpp"
+#include "numerics/row_blocks.hpp"
 
 namespace pwl {
+
+namespace banded_detail {
+
+std::vector<RowBlock> partition_rows(Index n, Index margin, Index cell) {
+  std::vector<RowBlock> blocks;
+  const Index step = cell > 0 ? cell : std::max<Index>(1, margin);
+  const Index left = cell > 0 ? std::max<Index>(cell, (margin + cell - 1) / cell * cell) : step;
+  const auto add = [&](Index b, Index e) {
+    blocks.push_back({b, e, std::max<Index>(0, b - margin), std::min(n, e + margin)});
+  };
+  if (left + margin >= n) {
+    add(0, n);
+    return blocks;
+  }
+  add(0, left);
+  Index r = left;
+  while (r + step + margin <= n) {
+    add(r, r + step);
+    r += step;
+  }
+  if (r < n) add(r, n);
+  return blocks;
+}
+
+}  // namespace banded_detail
 
 Vector interleave_state(const Vector& x, const Vector& v) {
   if (x.size() != v.size()) {
@@ -74,6 +100,9 @@ bool BandedExponentialOptions::is_valid(std::string* why) const {
 
 namespace {
 
+using banded_detail::RowBlock;
+using banded_detail::partition_rows;
+
 // The operator blocks whose dropped parts are measured: the four blocks of T, and the
 // displacement and velocity rows of the two linear-load integrals.
 constexpr int kTransitionBlocks = 0;  // + 2a + b: rows x (a = 0) or x' (a = 1), columns x or x'
@@ -88,35 +117,6 @@ std::string block_name(int type) {
   }
   if (type < kFallingBlocks) return fmt::format("rising load integral, {} rows", row[type - 4]);
   return fmt::format("falling load integral, {} rows", row[type - 6]);
-}
-
-struct RowBlock {
-  Index begin, end;                 // rows (degrees of freedom)
-  Index window_first, window_last;  // the substructure
-};
-
-// Blocks of rows with their substructures (margin R each side, clamped at the ends). With a
-// cell size p, the interior blocks are single cells, so that their substructures coincide in a
-// periodic structure; the rows near each end form one block whose substructure holds that end.
-std::vector<RowBlock> partition_rows(Index n, Index margin, Index cell) {
-  std::vector<RowBlock> blocks;
-  const Index step = cell > 0 ? cell : std::max<Index>(1, margin);
-  const Index left = cell > 0 ? std::max<Index>(cell, (margin + cell - 1) / cell * cell) : step;
-  const auto add = [&](Index b, Index e) {
-    blocks.push_back({b, e, std::max<Index>(0, b - margin), std::min(n, e + margin)});
-  };
-  if (left + margin >= n) {
-    add(0, n);
-    return blocks;
-  }
-  add(0, left);
-  Index r = left;
-  while (r + step + margin <= n) {
-    add(r, r + step);
-    r += step;
-  }
-  if (r < n) add(r, n);
-  return blocks;
 }
 
 // Largest (over rows) row sum and tail sums beyond each distance, per block type.

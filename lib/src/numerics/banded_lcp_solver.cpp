@@ -1,8 +1,9 @@
 // Banded LCP solver: block principal pivoting (Júdice & Pires, Computers & Operations Research
 // 21 (1994) 587-596) with Murty's single principal pivoting as the fall-back (Murty, Opsearch 11
-// (1974) 123-130), on active-set systems solved in O(size · bandwidth): Gauss-Seidel for a
-// diagonally dominant matrix, a band LU without pivoting otherwise (positive pivots on a
-// P-matrix: Cottle, Pang & Stone, The Linear Complementarity Problem, 1992, §3.3).
+// (1974) 123-130), whose pivoting rule is block_pivoting.hpp, on active-set systems solved in
+// O(size · bandwidth): Gauss-Seidel for a diagonally dominant matrix, a band LU without pivoting
+// otherwise (positive pivots on a P-matrix: Cottle, Pang & Stone, The Linear Complementarity
+// Problem, 1992, §3.3).
 #include "pwl/numerics/banded_lcp_solver.hpp"
 
 #include <algorithm>
@@ -12,19 +13,23 @@
 #include <fmt/format.h>
 
 #include "pwl/errors.hpp"
+#include "pwl/numerics/block_pivoting.hpp"
 
 namespace pwl {
 namespace {
 
-// As in the dense solver: entries of the complementary basic vector down to -kFeasTol |q|_inf
-// count as non-negative; pivots of M_AA below kSingularTol · width · max|M| mean singular.
-constexpr double kFeasTol = 1e-11;
+// As in the dense solver: pivots of M_AA below kSingularTol · width · max|M| mean singular.
 constexpr double kSingularTol = 1e-13;
-// Non-improving block iterations before Murty's rule.
-constexpr int kBlockTries = 3;
 // Gauss-Seidel stops when a sweep moves no force by more than this fraction of the largest (a
 // few units of rounding: the remaining error is at most dominance / (1 - dominance) times it).
 constexpr double kSweepTol = 4.0 * std::numeric_limits<double>::epsilon();
+
+LcpError iteration_limit(long iteration, Index n) {
+  return LcpError(fmt::format(
+      "banded block pivoting: no solution after {} iterations (n = {}), the iteration limit "
+      "(M is not a P-matrix?)",
+      iteration, n));
+}
 
 double row_dot(const BandedMatrix& M, Index i, const double* z) {
   const double* a = M.row_values(i);
@@ -134,9 +139,8 @@ LcpResult BandedLcpSolver::solve(const Eigen::Ref<const Vector>& q, Eigen::Ref<V
     qmin = std::min(qmin, q[i]);
   }
   LcpResult result;
-  const double tol_w = kFeasTol * qmax;
-  const double tol_z = tol_w / scale_;
-  if (qmin >= -tol_w) {  // z = 0 solves it
+  const block_pivoting::Tolerances tol = block_pivoting::tolerances(qmax, scale_);
+  if (block_pivoting::zero_solves(qmin, tol)) {  // z = 0 solves it
     z.setZero();
     for (Index i = 0; i < n; ++i) w[i] = std::max(q[i], 0.0);
     return result;
@@ -148,65 +152,58 @@ LcpResult BandedLcpSolver::solve(const Eigen::Ref<const Vector>& q, Eigen::Ref<V
     active_[static_cast<std::size_t>(i)] = z[i] > 0.0 ? 1 : 0;
     if (!(z[i] > 0.0)) z[i] = 0.0;
   }
-  double* zd = z.data();
-  int best_count = static_cast<int>(n) + 1;
-  int tries = kBlockTries;
-  for (long iter = 0;; ++iter) {
-    if (iter >= max_iterations_) {
-      throw LcpError(fmt::format(
-          "banded block pivoting: no solution after {} iterations (n = {}), the iteration limit "
-          "(M is not a P-matrix?)",
-          iter, n));
+
+  // The principal solves on the whole vector: x = (z_A, w_F) with w = q + M z from the columns
+  // of the active forces only (z is zero elsewhere).
+  struct Policy {
+    BandedLcpSolver& s;
+    const Eigen::Ref<const Vector>& q;
+    double* zd;
+    block_pivoting::Tolerances tol;
+    Index last = -1;  // the largest infeasible index
+
+    bool infeasible(Index i) const {
+      const bool in = s.active_[static_cast<std::size_t>(i)] != 0;
+      return s.x_[i] < -(in ? tol.z : tol.w);
     }
-    set_.clear();
-    for (Index i = 0; i < n; ++i) {
-      if (active_[static_cast<std::size_t>(i)]) set_.push_back(static_cast<int>(i));
-    }
-    solve_active(q, zd);
-    // w = q + M z from the columns of the active forces only (z is zero elsewhere).
-    x_ = q;
-    columns_.transpose_multiply_add(zd, x_.data());
-    int count = 0;
-    Index last = -1;
-    for (Index i = 0; i < n; ++i) {
-      const bool in = active_[static_cast<std::size_t>(i)] != 0;
-      if (in) x_[i] = zd[i];
-      if (x_[i] < -(in ? tol_z : tol_w)) {
-        ++count;
-        last = i;
-      }
-    }
-    if (count == 0) break;
-    const auto flip = [&](Index i) {
-      unsigned char& a = active_[static_cast<std::size_t>(i)];
+    // A force that enters starts from the value that zeroes its own slack; one that leaves is 0.
+    void flip(Index i) {
+      unsigned char& a = s.active_[static_cast<std::size_t>(i)];
       a ^= 1;
-      // A force that enters starts from the value that zeroes its own slack; one that leaves is 0.
-      zd[i] = a ? -q[i] / diagonal_[i] : 0.0;
+      zd[i] = a ? -q[i] / s.diagonal_[i] : 0.0;
       if (!(zd[i] > 0.0)) zd[i] = 0.0;
-    };
-    if (count < best_count || tries > 0) {
-      if (count < best_count) {
-        best_count = count;
-        tries = kBlockTries;
-      } else {
-        --tries;
-      }
-      for (Index i = 0; i < n; ++i) {
-        const bool in = active_[static_cast<std::size_t>(i)] != 0;
-        if (x_[i] < -(in ? tol_z : tol_w)) flip(i);
-      }
-      result.pivots += count;
-    } else {  // Murty: switch only the largest infeasible index
-      flip(last);
-      result.pivots += 1;
     }
-  }
-  for (Index i = 0; i < n; ++i) {
-    const double v = std::max(x_[i], 0.0);
-    const bool in = active_[static_cast<std::size_t>(i)] != 0;
-    z[i] = in ? v : 0.0;
-    w[i] = in ? 0.0 : v;
-  }
+    int evaluate(long) {
+      const Index n = s.M_.rows();
+      s.set_.clear();
+      for (Index i = 0; i < n; ++i) {
+        if (s.active_[static_cast<std::size_t>(i)]) s.set_.push_back(static_cast<int>(i));
+      }
+      s.solve_active(q, zd);
+      s.x_ = q;
+      s.columns_.transpose_multiply_add(zd, s.x_.data());
+      int count = 0;
+      last = -1;
+      for (Index i = 0; i < n; ++i) {
+        if (s.active_[static_cast<std::size_t>(i)] != 0) s.x_[i] = zd[i];
+        if (infeasible(i)) {
+          ++count;
+          last = i;
+        }
+      }
+      return count;
+    }
+    void exchange_infeasible() {
+      for (Index i = 0; i < s.M_.rows(); ++i)
+        if (infeasible(i)) flip(i);
+    }
+    void exchange_largest_infeasible() { flip(last); }
+    LcpError iteration_error(long iteration) const { return iteration_limit(iteration, s.M_.rows()); }
+  };
+  Policy policy{*this, q, z.data(), tol};
+  result.pivots += block_pivoting::solve(policy, static_cast<int>(n), max_iterations_);
+  block_pivoting::split_basic_vector(
+      x_, n, [&](Index i) { return active_[static_cast<std::size_t>(i)] != 0; }, z, w);
   return result;
 }
 
@@ -242,12 +239,11 @@ LcpResult BandedLcpSolver::solve_forces(const Eigen::Ref<const Vector>& q, Eigen
     qmax = std::max(qmax, std::abs(q[i]));
     if (q[i] < 0.0) negative_.push_back(static_cast<int>(i));
   }
-  const double tol_w = kFeasTol * qmax;
-  const double tol_z = tol_w / scale_;
+  const block_pivoting::Tolerances tol = block_pivoting::tolerances(qmax, scale_);
   double* zd = z.data();
   // As solve(): when no q_i is below -tol, z = 0 (and that is not counted as pivots).
   bool all_feasible = true;
-  for (int i : negative_) all_feasible = all_feasible && q[i] >= -tol_w;
+  for (int i : negative_) all_feasible = all_feasible && q[i] >= -tol.w;
   if (all_feasible) {
     for (int j : set_) {
       zd[j] = 0.0;
@@ -256,94 +252,95 @@ LcpResult BandedLcpSolver::solve_forces(const Eigen::Ref<const Vector>& q, Eigen
     set_.clear();
     return result;
   }
-  const Index cw = columns_.width();
-  int best_count = static_cast<int>(n) + 1;
-  int tries = kBlockTries;
-  for (long iter = 0;; ++iter) {
-    if (iter >= max_iterations_) {
-      throw LcpError(fmt::format(
-          "banded block pivoting: no solution after {} iterations (n = {}), the iteration limit "
-          "(M is not a P-matrix?)",
-          iter, n));
-    }
-    if (set_.empty()) {
-      // z = 0: feasible unless some q_i < -tol.
-      flips_.clear();
-      for (int i : negative_) {
-        if (q[i] < -tol_w) flips_.push_back(i);
+
+  // The principal solves on the springs near contact: only the indices with q_i < 0 and those
+  // within the band of an active one can be infeasible; flips_ collects them.
+  struct Policy {
+    BandedLcpSolver& s;
+    const Eigen::Ref<const Vector>& q;
+    double* zd;
+    block_pivoting::Tolerances tol;
+
+    int evaluate(long) {
+      if (s.set_.empty()) {
+        // z = 0: feasible unless some q_i < -tol.
+        s.flips_.clear();
+        for (int i : s.negative_) {
+          if (q[i] < -tol.w) s.flips_.push_back(i);
+        }
+        return static_cast<int>(s.flips_.size());
       }
-    } else {
-      solve_active(q, zd);
+      s.solve_active(q, zd);
       // M z on the band of the active set.
-      touched_.clear();
-      for (int j : set_) {
+      const Index cw = s.columns_.width();
+      s.touched_.clear();
+      for (int j : s.set_) {
         const double zj = zd[j];
-        const double* a = columns_.row_values(j);
-        const Index f = columns_.first_column(j);
+        const double* a = s.columns_.row_values(j);
+        const Index f = s.columns_.first_column(j);
         for (Index k = 0; k < cw; ++k) {
           if (a[k] == 0.0) continue;
           const auto i = static_cast<std::size_t>(f + k);
-          if (!seen_[i]) {
-            seen_[i] = 1;
-            touched_.push_back(static_cast<int>(i));
+          if (!s.seen_[i]) {
+            s.seen_[i] = 1;
+            s.touched_.push_back(static_cast<int>(i));
           }
-          scratch_[i] += a[k] * zj;
+          s.scratch_[i] += a[k] * zj;
         }
       }
-      flips_.clear();
-      for (int j : set_) {
-        if (zd[j] < -tol_z) flips_.push_back(j);
+      s.flips_.clear();
+      for (int j : s.set_) {
+        if (zd[j] < -tol.z) s.flips_.push_back(j);
       }
       const auto check_slack = [&](int i) {
-        if (active_[static_cast<std::size_t>(i)] || seen_[static_cast<std::size_t>(i)] == 2) return;
-        if (q[i] + scratch_[static_cast<std::size_t>(i)] < -tol_w) flips_.push_back(i);
-        seen_[static_cast<std::size_t>(i)] = 2;
+        const auto iu = static_cast<std::size_t>(i);
+        if (s.active_[iu] || s.seen_[iu] == 2) return;
+        if (q[i] + s.scratch_[iu] < -tol.w) s.flips_.push_back(i);
+        s.seen_[iu] = 2;
       };
-      for (int i : touched_) check_slack(i);
-      for (int i : negative_) check_slack(i);
-      for (int i : touched_) {
-        scratch_[static_cast<std::size_t>(i)] = 0.0;
-        seen_[static_cast<std::size_t>(i)] = 0;
+      for (int i : s.touched_) check_slack(i);
+      for (int i : s.negative_) check_slack(i);
+      for (int i : s.touched_) {
+        s.scratch_[static_cast<std::size_t>(i)] = 0.0;
+        s.seen_[static_cast<std::size_t>(i)] = 0;
       }
-      for (int i : negative_) seen_[static_cast<std::size_t>(i)] = 0;
+      for (int i : s.negative_) s.seen_[static_cast<std::size_t>(i)] = 0;
+      return static_cast<int>(s.flips_.size());
     }
-    const int count = static_cast<int>(flips_.size());
-    if (count == 0) break;
-    if (count < best_count || tries > 0) {
-      if (count < best_count) {
-        best_count = count;
-        tries = kBlockTries;
-      } else {
-        --tries;
+    void exchange_infeasible() { flip(); }
+    void exchange_largest_infeasible() {
+      const int last = *std::max_element(s.flips_.begin(), s.flips_.end());
+      s.flips_.assign(1, last);
+      flip();
+    }
+    // Switches the indices in flips_ and forms the new active set, ascending: the old one
+    // without the leavers, merged with the entrants.
+    void flip() {
+      for (int i : s.flips_) {
+        unsigned char& a = s.active_[static_cast<std::size_t>(i)];
+        a ^= 1;
+        zd[i] = a ? std::max(0.0, -q[i] / s.diagonal_[i]) : 0.0;
       }
-      result.pivots += count;
-    } else {  // Murty: switch only the largest infeasible index
-      const int last = *std::max_element(flips_.begin(), flips_.end());
-      flips_.assign(1, last);
-      result.pivots += 1;
-    }
-    for (int i : flips_) {
-      unsigned char& a = active_[static_cast<std::size_t>(i)];
-      a ^= 1;
-      zd[i] = a ? std::max(0.0, -q[i] / diagonal_[i]) : 0.0;
-    }
-    // The new active set, ascending: the old one without the leavers, merged with the entrants.
-    std::sort(flips_.begin(), flips_.end());
-    std::vector<int>& merged = touched_;  // reused as scratch
-    merged.clear();
-    std::size_t a = 0, b = 0;
-    while (a < set_.size() || b < flips_.size()) {
-      if (b == flips_.size() || (a < set_.size() && set_[a] < flips_[b])) {
-        merged.push_back(set_[a++]);
-      } else if (a == set_.size() || flips_[b] < set_[a]) {
-        merged.push_back(flips_[b++]);  // entered
-      } else {
-        ++a;  // left
-        ++b;
+      std::sort(s.flips_.begin(), s.flips_.end());
+      std::vector<int>& merged = s.touched_;  // reused as scratch
+      merged.clear();
+      std::size_t a = 0, b = 0;
+      while (a < s.set_.size() || b < s.flips_.size()) {
+        if (b == s.flips_.size() || (a < s.set_.size() && s.set_[a] < s.flips_[b])) {
+          merged.push_back(s.set_[a++]);
+        } else if (a == s.set_.size() || s.flips_[b] < s.set_[a]) {
+          merged.push_back(s.flips_[b++]);  // entered
+        } else {
+          ++a;  // left
+          ++b;
+        }
       }
+      s.set_.swap(merged);
     }
-    set_.swap(merged);
-  }
+    LcpError iteration_error(long iteration) const { return iteration_limit(iteration, s.M_.rows()); }
+  };
+  Policy policy{*this, q, zd, tol};
+  result.pivots += block_pivoting::solve(policy, static_cast<int>(n), max_iterations_);
   for (int j : set_) zd[j] = std::max(zd[j], 0.0);
   return result;
 }

@@ -6,12 +6,9 @@
 //   R. W. Cottle, J.-S. Pang, R. E. Stone, The Linear Complementarity Problem, Academic Press
 //     1992: Lemke's scheme 1 with covering vector (§4.4), lexicographic degeneracy resolution
 //     (§4.9), P-matrices (§3.3).
-//   J. J. Júdice, F. M. Pires, "A block principal pivoting algorithm for large-scale strictly
-//     monotone linear complementarity problems", Computers & Operations Research 21 (1994)
-//     587-596: block pivoting with a counter of infeasibilities.
-//   K. G. Murty, "Note on a Bard-type scheme for solving the complementarity problem", Opsearch
-//     11 (1974) 123-130: single principal pivoting on the largest infeasible index, finite for
-//     P-matrices; the fall-back of the block method.
+//   J. J. Júdice, F. M. Pires 1994 and K. G. Murty 1974: block principal pivoting with Murty's
+//     fall-back, whose pivoting rule is block_pivoting.hpp (cited there); this file gives it the
+//     principal solves of a dense M.
 //
 // Both solvers are called once per integration step (~10^7 times per run) with the same M and a
 // slowly changing q, so all storage is sized in set_matrix and solve() does not allocate.
@@ -32,13 +29,13 @@
 #include <Eigen/Cholesky>
 
 #include "pwl/errors.hpp"
+#include "pwl/numerics/block_pivoting.hpp"
 
 namespace pwl {
 namespace {
 
-// Entries of the complementary basic vector down to -kFeasTol * |q|_inf count as non-negative
-// (and are clamped to 0 on output). Relative to q so that the answer does not depend on units.
-constexpr double kFeasTol = 1e-11;
+// The feasibility tolerance of block_pivoting.hpp, relative to |q|_inf; Lemke's ties use it too.
+constexpr double kFeasTol = block_pivoting::kFeasibilityTolerance;
 // A pivot of an LU factorisation of magnitude <= kSingularTol * k * max|entry| means singular.
 constexpr double kSingularTol = 1e-13;
 // Lemke: entries of the entering column <= kPivotTol * max(1, column max) do not block.
@@ -46,8 +43,7 @@ constexpr double kPivotTol = 1e-12;
 // is_p_matrix: a principal minor must exceed this fraction of the product of its rows' 2-norms
 // (Hadamard's bound on |det|), otherwise it is zero to working precision.
 constexpr double kMinorTol = 1e-12;
-// Block pivoting: non-improving block iterations allowed before Murty's rule (Júdice & Pires).
-constexpr int kBlockTries = 3;
+constexpr int kBlockTries = block_pivoting::kBlockTries;
 // Active sets up to this size are encoded as bitmasks and their transforms cached.
 constexpr Index kMaxCachedSize = 12;
 
@@ -345,16 +341,8 @@ class LemkeSolver final : public LcpSolver {
 };
 
 // ---------------------------------------------------------------------------------------------
-// Block principal pivoting (Júdice & Pires 1994) with Murty's fall-back.
-//
-// For an active set A (z_i basic for i in A, w_i basic otherwise) the complementary basic
-// vector x (x_A = z_A, x_F = w_F) is
-//     z_A = -M_AA^{-1} q_A,    w_F = q_F + M_FA z_A,
-// and A solves the LCP iff x >= 0. The infeasible indices H = {i : x_i < 0} are switched all at
-// once while that reduces |H| (or for up to kBlockTries non-improving iterations); after that
-// only the largest index in H is switched (Murty), until |H| drops below its best value again.
-// For a P-matrix every Murty run is finite and |H|'s best value only decreases, so the method
-// terminates.
+// Block principal pivoting (Júdice & Pires 1994) with Murty's fall-back: the rule of
+// block_pivoting.hpp with the principal solves of a dense M.
 //
 // For n <= 12, x = T_A q with an n x n matrix T_A that depends only on M and A; T_A is computed
 // the first time A is met and cached, keyed by A's bitmask, so a warm-started step whose active
@@ -403,18 +391,16 @@ class BlockPivotingSolver final : public LcpSolver {
                   Eigen::Ref<Vector> w) override {
     const RhsInfo info = validate_solve("block pivoting", has_matrix_, n_, q, z, w);
     LcpResult result;
-    const double tol_w = kFeasTol * info.qmax;
-    // z entries scale like q / M: this bound keeps M z within tol_w.
-    const double tol_z = tol_w / mscale_;
-    if (info.qmin >= -tol_w) {  // z = 0 solves it
+    const block_pivoting::Tolerances tol = block_pivoting::tolerances(info.qmax, mscale_);
+    if (block_pivoting::zero_solves(info.qmin, tol)) {
       z.setZero();
       for (Index i = 0; i < n_; ++i) w[i] = std::max(q[i], 0.0);
       return result;
     }
     if (n_ <= kMaxCachedSize)
-      (this->*small_solve_)(q, z, w, tol_w, tol_z, result);
+      (this->*small_solve_)(q, z, w, tol, result);
     else
-      solve_large(q, z, w, tol_w, tol_z, result);
+      solve_large(q, z, w, tol, result);
     return result;
   }
 
@@ -465,127 +451,111 @@ class BlockPivotingSolver final : public LcpSolver {
     return T;
   }
 
-  // Instantiated for every size 1..12 (n = N): with the size known at compile time the
-  // matrix-vector product and the loops unroll (about 30% fewer instructions per warm step).
+  // The principal solves for n = N <= 12: x = T_A q with the cached transform of A. Instantiated
+  // for every size 1..12: with the size known at compile time the matrix-vector product and the
+  // loops unroll (about 30% fewer instructions per warm step).
+  template <int N>
+  struct CachedInversePolicy : block_pivoting::MaskedActiveSet {
+    BlockPivotingSolver& solver;
+    const double* q;
+    block_pivoting::Tolerances tol;
+    double x[kMaxCachedSize];
+
+    int evaluate(long iteration) {
+      const double* T = solver.transform(mask, iteration);
+      for (int i = 0; i < N; ++i) {
+        const double* Ti = T + i * N;
+        double s = 0.0;
+        for (int j = 0; j < N; ++j) s += Ti[j] * q[j];
+        x[i] = s;
+      }
+      return mark_infeasible(x, N, tol);
+    }
+    LcpError iteration_error(long iteration) const { return solver.iteration_limit(iteration); }
+  };
+
   template <int N>
   void solve_small(const Eigen::Ref<const Vector>& q, Eigen::Ref<Vector> z, Eigen::Ref<Vector> w,
-                   double tol_w, double tol_z, LcpResult& result) {
-    constexpr int n = N;
-    std::uint32_t mask = 0;
-    for (int i = 0; i < n; ++i)
-      if (z[i] > 0.0) mask |= 1u << i;
-    const double* qd = q.data();
-    double x[kMaxCachedSize];
-    int best_count = n + 1;
-    int tries = kBlockTries;
-    for (long iter = 0;; ++iter) {
-      if (iter >= max_iter_) throw iteration_limit(iter);
-      const double* T = transform(mask, iter);
-      std::uint32_t infeasible = 0;
-      for (int i = 0; i < n; ++i) {
-        const double* Ti = T + i * n;
-        double s = 0.0;
-        for (int j = 0; j < n; ++j) s += Ti[j] * qd[j];
-        x[i] = s;
-        const double tol = (mask >> i & 1u) ? tol_z : tol_w;
-        if (s < -tol) infeasible |= 1u << i;
-      }
-      if (infeasible == 0) break;
-      const int count = std::popcount(infeasible);
-      if (count < best_count || tries > 0) {
-        if (count < best_count) {
-          best_count = count;
-          tries = kBlockTries;
-        } else {
-          --tries;
-        }
-        mask ^= infeasible;
-        result.pivots += count;
-      } else {  // Murty: switch only the largest infeasible index
-        mask ^= 1u << (31 - std::countl_zero(infeasible));
-        result.pivots += 1;
-      }
-    }
-    for (int i = 0; i < n; ++i) {
-      const double v = std::max(x[i], 0.0);
-      const bool basic_z = mask >> i & 1u;
-      z[i] = basic_z ? v : 0.0;
-      w[i] = basic_z ? 0.0 : v;
-    }
+                   const block_pivoting::Tolerances& tol, LcpResult& result) {
+    CachedInversePolicy<N> policy{{}, *this, q.data(), tol, {}};
+    for (int i = 0; i < N; ++i)
+      if (z[i] > 0.0) policy.mask |= 1u << i;
+    result.pivots += block_pivoting::solve(policy, N, max_iter_);
+    block_pivoting::split_basic_vector(
+        policy.x, N, [&](Index i) { return (policy.mask >> i & 1u) != 0; }, z, w);
   }
 
-  // Size > 12: factor M_AA for each new active set; the factorisation of the last one is kept,
-  // so a step whose active set did not change costs two triangular solves and M_FA z_A.
-  void solve_large(const Eigen::Ref<const Vector>& q, Eigen::Ref<Vector> z, Eigen::Ref<Vector> w,
-                   double tol_w, double tol_z, LcpResult& result) {
-    const Index n = n_;
-    for (Index i = 0; i < n; ++i) active_[static_cast<std::size_t>(i)] = z[i] > 0.0 ? 1 : 0;
-    int best_count = static_cast<int>(n) + 1;
-    int tries = kBlockTries;
-    double* x = x_.data();
-    for (long iter = 0;; ++iter) {
-      if (iter >= max_iter_) throw iteration_limit(iter);
+  // The principal solves for n > 12: M_AA is factored for each new active set; the
+  // factorisation of the last one is kept, so a step whose active set did not change costs two
+  // triangular solves and M_FA z_A.
+  struct FactoredBlockPolicy {
+    BlockPivotingSolver& solver;
+    const Eigen::Ref<const Vector>& q;
+    block_pivoting::Tolerances tol;
+    Index last = -1;  // the largest infeasible index
+
+    bool infeasible(Index i) const {
+      const double t = solver.active_[static_cast<std::size_t>(i)] ? tol.z : tol.w;
+      return solver.x_[static_cast<std::size_t>(i)] < -t;
+    }
+    int evaluate(long iteration) {
+      BlockPivotingSolver& s = solver;
+      const Index n = s.n_;
       int k = 0;
       for (Index i = 0; i < n; ++i)
-        if (active_[static_cast<std::size_t>(i)]) idx_a_[static_cast<std::size_t>(k++)] =
+        if (s.active_[static_cast<std::size_t>(i)]) s.idx_a_[static_cast<std::size_t>(k++)] =
             static_cast<int>(i);
-      if (!fact_valid_ || active_ != fact_active_) {
-        fact_valid_ = false;
+      if (!s.fact_valid_ || s.active_ != s.fact_active_) {
+        s.fact_valid_ = false;
         double amax = 0.0;
         for (int a = 0; a < k; ++a)
           for (int b = 0; b < k; ++b) {
-            const double v = M_(idx_a_[a], idx_a_[b]);
-            lu_[static_cast<std::size_t>(a * k + b)] = v;
+            const double v = s.M_(s.idx_a_[a], s.idx_a_[b]);
+            s.lu_[static_cast<std::size_t>(a * k + b)] = v;
             amax = std::max(amax, std::abs(v));
           }
-        if (lu_factor(lu_.data(), k, perm_.data(), kSingularTol * k * amax) >= 0)
-          throw singular_block(idx_a_.data(), k, iter);
-        fact_active_ = active_;  // same size: no allocation
-        fact_valid_ = true;
+        if (lu_factor(s.lu_.data(), k, s.perm_.data(), kSingularTol * k * amax) >= 0)
+          throw s.singular_block(s.idx_a_.data(), k, iteration);
+        s.fact_active_ = s.active_;  // same size: no allocation
+        s.fact_valid_ = true;
       }
-      double* zA = y_.data();
-      for (int a = 0; a < k; ++a) zA[a] = -q[idx_a_[a]];
-      lu_solve(lu_.data(), k, perm_.data(), zA);
+      double* x = s.x_.data();
+      double* zA = s.y_.data();
+      for (int a = 0; a < k; ++a) zA[a] = -q[s.idx_a_[a]];
+      lu_solve(s.lu_.data(), k, s.perm_.data(), zA);
       for (Index i = 0; i < n; ++i) x[i] = q[i];
       for (int a = 0; a < k; ++a) {
         const double za = zA[a];
-        const double* col = M_.data() + static_cast<Index>(idx_a_[a]) * n;
+        const double* col = s.M_.data() + static_cast<Index>(s.idx_a_[a]) * n;
         for (Index i = 0; i < n; ++i) x[i] += col[i] * za;
       }
-      for (int a = 0; a < k; ++a) x[idx_a_[a]] = zA[a];
+      for (int a = 0; a < k; ++a) x[s.idx_a_[a]] = zA[a];
       int count = 0;
-      Index last = -1;
+      last = -1;
       for (Index i = 0; i < n; ++i) {
-        const double tol = active_[static_cast<std::size_t>(i)] ? tol_z : tol_w;
-        if (x[i] < -tol) {
+        if (infeasible(i)) {
           ++count;
           last = i;
         }
       }
-      if (count == 0) break;
-      if (count < best_count || tries > 0) {
-        if (count < best_count) {
-          best_count = count;
-          tries = kBlockTries;
-        } else {
-          --tries;
-        }
-        for (Index i = 0; i < n; ++i) {
-          const double tol = active_[static_cast<std::size_t>(i)] ? tol_z : tol_w;
-          if (x[i] < -tol) active_[static_cast<std::size_t>(i)] ^= 1;
-        }
-        result.pivots += count;
-      } else {
-        active_[static_cast<std::size_t>(last)] ^= 1;
-        result.pivots += 1;
-      }
+      return count;
     }
-    for (Index i = 0; i < n; ++i) {
-      const double v = std::max(x[i], 0.0);
-      const bool basic_z = active_[static_cast<std::size_t>(i)] != 0;
-      z[i] = basic_z ? v : 0.0;
-      w[i] = basic_z ? 0.0 : v;
+    void exchange_infeasible() {
+      for (Index i = 0; i < solver.n_; ++i)
+        if (infeasible(i)) solver.active_[static_cast<std::size_t>(i)] ^= 1;
     }
+    void exchange_largest_infeasible() { solver.active_[static_cast<std::size_t>(last)] ^= 1; }
+    LcpError iteration_error(long iteration) const { return solver.iteration_limit(iteration); }
+  };
+
+  void solve_large(const Eigen::Ref<const Vector>& q, Eigen::Ref<Vector> z, Eigen::Ref<Vector> w,
+                   const block_pivoting::Tolerances& tol, LcpResult& result) {
+    const Index n = n_;
+    for (Index i = 0; i < n; ++i) active_[static_cast<std::size_t>(i)] = z[i] > 0.0 ? 1 : 0;
+    FactoredBlockPolicy policy{*this, q, tol};
+    result.pivots += block_pivoting::solve(policy, static_cast<int>(n), max_iter_);
+    block_pivoting::split_basic_vector(
+        x_, n, [&](Index i) { return active_[static_cast<std::size_t>(i)] != 0; }, z, w);
   }
 
   LcpError singular_block(const int* idx, int k, long iter) const {
@@ -603,8 +573,8 @@ class BlockPivotingSolver final : public LcpSolver {
   }
 
   using SmallSolve = void (BlockPivotingSolver::*)(const Eigen::Ref<const Vector>&,
-                                                   Eigen::Ref<Vector>, Eigen::Ref<Vector>, double,
-                                                   double, LcpResult&);
+                                                   Eigen::Ref<Vector>, Eigen::Ref<Vector>,
+                                                   const block_pivoting::Tolerances&, LcpResult&);
   template <std::size_t... I>
   static std::array<SmallSolve, sizeof...(I)> small_solvers(std::index_sequence<I...>) {
     return {&BlockPivotingSolver::solve_small<static_cast<int>(I) + 1>...};

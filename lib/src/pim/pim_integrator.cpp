@@ -62,38 +62,31 @@ class PimIntegrator final : public Integrator {
 
  private:
   void advance(double t_end, Matrix* tangent, const StepObserver& observer) {
-    const double eta = propagator_.step_size();
-    const long count = detail::fixed_step_count(t_end, propagator_.time(), eta);
+    const auto publish = [this] { sync(); };
+    const auto advance_by = [&](auto&& step) {
+      stats_.steps += detail::advance_on_grid(t_end, propagator_.time(), propagator_.step_size(),
+                                              observer, position_, velocity_, step, publish);
+    };
     if constexpr (Dofs != Eigen::Dynamic && Dofs == Springs) {
       // One tangent vector on fixed-size storage (λ1 alone): the single-vector map.
       if (tangent != nullptr && tangent->cols() == 1 && tangent->rows() == 2 * Dofs) {
         typename PrecisePropagator<Dofs, Springs>::StateVector y = *tangent;
-        for (long k = 0; k < count; ++k) {
+        advance_by([&] {
           propagator_.step();
           propagator_.apply_step_tangent_vector(y);
           stats_.lcp_pivots += propagator_.last_lcp_pivots();
-          if (observer) {
-            sync();
-            observer(propagator_.time(), position_, velocity_);
-          }
-        }
+          return propagator_.time();
+        });
         *tangent = y;
-        stats_.steps += count;
-        sync();
         return;
       }
     }
-    for (long k = 0; k < count; ++k) {
+    advance_by([&] {
       propagator_.step();
       if (tangent != nullptr) propagator_.apply_step_tangent(*tangent);
       stats_.lcp_pivots += propagator_.last_lcp_pivots();
-      if (observer) {
-        sync();
-        observer(propagator_.time(), position_, velocity_);
-      }
-    }
-    stats_.steps += count;
-    sync();
+      return propagator_.time();
+    });
   }
 
   void sync() {

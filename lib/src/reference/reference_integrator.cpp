@@ -35,6 +35,7 @@
 #include <fmt/format.h>
 
 #include "pwl/errors.hpp"
+#include "pwl/numerics/state_checks.hpp"
 #include "reference/reference_rhs.hpp"
 
 namespace pwl {
@@ -167,20 +168,7 @@ class RungeKuttaIntegrator final : public Integrator {
 
   void set_state(double t, const Vector& x, const Vector& v) override {
     const Index n = dofs();
-    if (x.size() != n || v.size() != n) {
-      throw InputError(fmt::format("set_state: x has size {} and v has size {}; both must be {} "
-                                   "(the structure's degrees of freedom)",
-                                   x.size(), v.size(), n));
-    }
-    if (!std::isfinite(t)) throw InputError(fmt::format("set_state: t = {} is not finite", t));
-    for (Index i = 0; i < n; ++i) {
-      if (!std::isfinite(x[i])) {
-        throw InputError(fmt::format("set_state: x[{}] = {} is not finite", i, x[i]));
-      }
-      if (!std::isfinite(v[i])) {
-        throw InputError(fmt::format("set_state: v[{}] = {} is not finite", i, v[i]));
-      }
-    }
+    check_initial_state(t, x, v, n);
     t_ = t;
     y_.head(n) = x;
     y_.tail(n) = v;

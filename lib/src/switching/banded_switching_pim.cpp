@@ -19,6 +19,8 @@
 #include "pwl/errors.hpp"
 #include "integrators/fixed_step_count.hpp"
 #include "pwl/numerics/substructure_exponential.hpp"
+#include "pwl/numerics/state_checks.hpp"
+#include "numerics/row_blocks.hpp"
 #include "switching/switching_pim_detail.hpp"
 
 namespace pwl {
@@ -43,66 +45,16 @@ bool BandedSwitchingPimOptions::is_valid(std::string* why) const {
 
 namespace {
 
-using event_detail::GapSample;
-using switching_detail::PolynomialGaps;
 using RowSparse = Eigen::SparseMatrix<double, Eigen::RowMajor>;
-constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
+using switching_detail::kEpsilon;
 
-// The coefficients of the step's force polynomial (switching_pim.cpp, make_operators and the
-// stepper's constructor) from the moments Ξ̂_0 .. Ξ̂_{d+1} (Ξ̂_{d+2} with the end slope):
-// correction[r] multiplies p_r (with the end slope, the predicted slope Σ r p_r folded in, and one
-// more for p_{d+1}), phi multiplies P_{k+1}, slope the correction of η P'_{k+1}.
-struct ForceCoefficients {
-  std::vector<Matrix> correction;
-  Matrix phi, slope;
-};
+using switching_detail::ForceCoefficients;
+using switching_detail::force_coefficients;
 
-ForceCoefficients force_coefficients(const std::vector<Matrix>& moments, int d, bool end) {
-  const auto moment = [&](int r) -> const Matrix& { return moments[static_cast<std::size_t>(r)]; };
-  ForceCoefficients c;
-  if (!end) {
-    c.phi = moment(d + 1);
-    for (int r = 0; r <= d; ++r) c.correction.push_back(moment(r) - c.phi);
-    c.slope = Matrix::Zero(c.phi.rows(), c.phi.cols());
-    return c;
-  }
-  const Matrix delta = moment(d + 2) - moment(d + 1);
-  c.phi = moment(d + 1) - (d + 1) * delta;
-  for (int r = 0; r <= d; ++r) c.correction.push_back(moment(r) - moment(d + 1) + (d + 1 - r) * delta);
-  c.slope = delta;
-  for (int r = 1; r <= d; ++r) c.correction[static_cast<std::size_t>(r)] += r * c.slope;
-  c.correction.push_back((d + 1) * c.slope);
-  return c;
-}
-
-// Row blocks with their substructures, partitioned as banded_exponential.cpp does (margin R on
-// each side, clamped at the ends; single cells in the interior of a periodic structure, so that
-// their substructures coincide).
-struct RowBlock {
-  Index begin, end;
-  Index window_first, window_last;
-};
-
-std::vector<RowBlock> partition_rows(Index n, Index margin, Index cell) {
-  std::vector<RowBlock> blocks;
-  const Index step = cell > 0 ? cell : std::max<Index>(1, margin);
-  const Index left = cell > 0 ? std::max<Index>(cell, (margin + cell - 1) / cell * cell) : step;
-  const auto add = [&](Index b, Index e) {
-    blocks.push_back({b, e, std::max<Index>(0, b - margin), std::min(n, e + margin)});
-  };
-  if (left + margin >= n) {
-    add(0, n);
-    return blocks;
-  }
-  add(0, left);
-  Index r = left;
-  while (r + step + margin <= n) {
-    add(r, r + step);
-    r += step;
-  }
-  if (r < n) add(r, n);
-  return blocks;
-}
+// Row blocks with their substructures, partitioned as the banded exponential's
+// (row_blocks.hpp), so that the coefficients come from the same substructures.
+using banded_detail::RowBlock;
+using banded_detail::partition_rows;
 
 // The force coefficients for unit accelerations at every degree of freedom (G = [0; I]) as banded
 // 2n x n matrices on the interleaved state, band q: each row read off the substructure of its
@@ -177,7 +129,11 @@ struct LoadTerm {
   Vector cos_part;
 };
 
-class BandedStepper final : public SwitchingPim {
+class BandedStepper final : public SwitchingPim,
+                            private switching_detail::ModeSeries<BandedStepper, Vector, Vector> {
+  friend switching_detail::ModeSeries<BandedStepper, Vector, Vector>;
+  static constexpr const char* kMethodName = "pim-switching-banded";
+
  public:
   BandedStepper(const GapStructure& s, const BandedSwitchingPimOptions& options)
       : o_(options.pim), n_(s.dofs()), m_(s.spring_count()), d_(options.pim.force_degree),
@@ -272,18 +228,12 @@ class BandedStepper final : public SwitchingPim {
     }
 
     const int terms = std::max(o_.max_series_terms, d_ + 2) + 1;
-    xs_.assign(static_cast<std::size_t>(terms), Vector::Zero(n_));
-    us_.assign(static_cast<std::size_t>(terms), Vector::Zero(n_));
-    ps_.assign(static_cast<std::size_t>(terms), Vector::Zero(m_));
-    gw_.assign(static_cast<std::size_t>(terms), Vector::Zero(m_));
+    size_series(static_cast<std::size_t>(terms), n_, m_);
     mode_ = Vector::Zero(m_);
     signs_ = Vector::Constant(m_, -1.0);
     state_ = Vector::Zero(2 * n_);
     bar_ = state_;
-    acc_ = Vector::Zero(n_);
-    half_ = acc_;
-    vx_ = acc_;
-    vu_ = acc_;
+    half_ = Vector::Zero(n_);
     z_ = Vector::Zero(m_);
     q_ = z_;
     slope_guess_ = z_;
@@ -305,13 +255,7 @@ class BandedStepper final : public SwitchingPim {
   SwitchingPimDiagnostics diagnostics() const override { return diagnostics_; }
 
   void set_state(double t, const Vector& x, const Vector& v) override {
-    if (x.size() != n_ || v.size() != n_) {
-      throw InputError(fmt::format("state has {} displacements and {} velocities, expected {}",
-                                   x.size(), v.size(), n_));
-    }
-    if (!std::isfinite(t) || !x.allFinite() || !v.allFinite()) {
-      throw InputError(fmt::format("initial state at t = {} has a non-finite entry", t));
-    }
+    check_initial_state(t, x, v, n_);
     origin_ = t;
     steps_ = 0;
     state_ = interleave_state(x, v);
@@ -325,15 +269,13 @@ class BandedStepper final : public SwitchingPim {
   }
 
   void advance_to(double t_end, const StepObserver& observer) override {
-    const long count = detail::fixed_step_count(t_end, time(), eta_);
-    for (long k = 0; k < count; ++k) {
-      step();
-      if (observer) {
-        sync();
-        observer(time(), position_, velocity_);
-      }
-    }
-    sync();
+    detail::advance_on_grid(
+        t_end, time(), eta_, observer, position_, velocity_,
+        [this] {
+          step();
+          return time();
+        },
+        [this] { sync(); });
   }
 
  private:
@@ -365,119 +307,27 @@ class BandedStepper final : public SwitchingPim {
     }
   }
 
-  // Scaled Taylor coefficients of the motion in the current mode about time t for a step h, as
-  // in switching_pim.cpp but with sparse products: xs_[r] = x^{(r)} h^r / r!, us_[r] the same for
-  // x', ps_[r] = P^{(r)} h^r / r!, gw_[r] = W^T xs_[r]. xs_[0] and us_[0] hold the start. Computes
-  // xs_ and gw_ up to `last`, us_ and ps_ up to last - 1 (us_[last] too when full). When
-  // tol > 0, stops once two consecutive terms are below tol times the largest; returns the index
-  // of the last term computed. With first > 0 the terms up to `first` are those of a call with
-  // the same t, h and start that stopped there, and the series continues from them.
-  int taylor(double t, double h, int last, double tol, bool full = true, int first = 0) {
-    double largest = 0.0;
-    if (first == 0) {
-      gw_[0].noalias() = gap_rows_ * xs_[0];
-      for (std::size_t g = 0; g < loads_.size(); ++g) {
-        phase_sin_[g] = std::sin(loads_[g].omega * t);
-        phase_cos_[g] = std::cos(loads_[g].omega * t);
-        load_scale_[g] = 1.0;
-      }
-    }
-    for (int r = 0; r < first; ++r) {
-      largest = std::max({largest, xs_[static_cast<std::size_t>(r)].cwiseAbs().maxCoeff(),
-                          us_[static_cast<std::size_t>(r)].cwiseAbs().maxCoeff()});
-    }
-    largest = std::max({largest, xs_[static_cast<std::size_t>(first)].cwiseAbs().maxCoeff(),
-                        first == 0 ? us_[0].cwiseAbs().maxCoeff() : 0.0});
-    double previous = largest;
-    for (int r = first; r < last; ++r) {
-      const auto ru = static_cast<std::size_t>(r);
-      ps_[ru] = mode_.cwiseProduct(stiffnesses_.cwiseProduct(gw_[ru]));
-      if (r == 0) ps_[ru] -= mode_.cwiseProduct(spring_offset_);
-      const double f = h / (r + 1);
-      xs_[ru + 1] = f * us_[ru];
-      gw_[ru + 1].noalias() = gap_rows_ * xs_[ru + 1];
-      if (!full && r + 1 == last) break;  // the last velocity term is not needed
-      acc_.noalias() = stiffness_part_ * xs_[ru];
-      acc_.noalias() += damping_part_ * us_[ru];
-      if (!acting_.empty()) acc_.noalias() += force_part_ * ps_[ru];
-      for (std::size_t g = 0; g < loads_.size(); ++g) {
-        // d^r/dt^r of sin and cos at ωt, scaled by (ωh)^r / r!: the cycle (S, C, -S, -C).
-        const double S = phase_sin_[g], C = phase_cos_[g];
-        double ds = 0.0, dc = 0.0;
-        switch (r % 4) {
-          case 0: ds = S; dc = C; break;
-          case 1: ds = C; dc = -S; break;
-          case 2: ds = -S; dc = -C; break;
-          default: ds = -C; dc = S; break;
-        }
-        const double scale = load_scale_[g];
-        if (scale != 0.0) acc_ += scale * (ds * loads_[g].sin_part + dc * loads_[g].cos_part);
-        load_scale_[g] = scale * loads_[g].omega * h / (r + 1);
-      }
-      us_[ru + 1] = f * acc_;
-      if (tol > 0.0) {
-        const double size =
-            std::max(xs_[ru + 1].cwiseAbs().maxCoeff(), us_[ru + 1].cwiseAbs().maxCoeff());
-        largest = std::max(largest, size);
-        if (r + 1 >= 4 && size + previous <= tol * largest) return r + 1;
-        previous = size;
-      }
-    }
-    return last;
+  // The hooks of ModeSeries (switching_pim_detail.hpp), which holds the Taylor recursion and the
+  // pieces of switching steps, here with sparse products; xs_[0] and us_[0] hold the start.
+  void gap_product(const Vector& x, Vector& out) const { out.noalias() = gap_rows_ * x; }
+  void acceleration(const Vector& x, const Vector& u, const Vector& p, Vector& acc) const {
+    acc.noalias() = stiffness_part_ * x;
+    acc.noalias() += damping_part_ * u;
+    if (!acting_.empty()) acc.noalias() += force_part_ * p;
   }
-
-  // Σ_r a_r σ^r for the state, into vx_ and vu_.
-  void evaluate_series(int R, double sigma) {
-    vx_ = xs_[static_cast<std::size_t>(R)];
-    vu_ = us_[static_cast<std::size_t>(R)];
-    for (int r = R - 1; r >= 0; --r) {
-      vx_ = vx_ * sigma + xs_[static_cast<std::size_t>(r)];
-      vu_ = vu_ * sigma + us_[static_cast<std::size_t>(r)];
-    }
-  }
-
-  double kink_tolerance(Index j, const Vector& x) const {
+  double kink_tolerance(Index j) const {
     double reach = 0.0;
     for (RowSparse::InnerIterator it(gap_rows_, j); it; ++it) {
-      reach += std::abs(it.value()) * std::abs(x[it.col()]);
+      reach += std::abs(it.value()) * std::abs(xs_[0][it.col()]);
     }
     return 64.0 * kEpsilon * (std::abs(gaps_[j]) + reach + abs_row_sums_[j] * x_scale_);
   }
-
-  // The gap polynomial of gw_[0..R] (mode-signed) on σ in [0, 1]; settles the springs on their
-  // kink at σ = 0 (switching_pim.cpp). Returns true when a spring must switch at σ = 0.
-  bool prepare_polynomial(int R) {
-    poly_.c.resize(m_, R + 1);
-    for (int r = 0; r <= R; ++r) {
-      const auto ru = static_cast<std::size_t>(r);
-      if (r == 0) {
-        poly_.c.col(0) = signs_.cwiseProduct(gw_[0] - gaps_);
-      } else {
-        poly_.c.col(r) = signs_.cwiseProduct(gw_[ru]);
-      }
+  void begin_piece() { collect_acting(); }
+  void end_pieces() {
+    for (Index i = 0; i < n_; ++i) {
+      state_[2 * i] = xs_[0][i];
+      state_[2 * i + 1] = us_[0][i];
     }
-    start_ = GapSample();
-    poly_.sample(start_, 0.0, start_);
-    settings_.nominal_spacing = 1.0;
-    settings_.max_spacing = 0.0;
-    settings_.min_width = 64.0 * kEpsilon;
-    settings_.tolerance = Vector::Zero(m_);
-    settings_.certified_until = Vector::Constant(m_, -std::numeric_limits<double>::infinity());
-    flip_.clear();
-    for (Index j = 0; j < m_; ++j) {
-      const double tol = kink_tolerance(j, xs_[0]);
-      if (start_.e[j] > tol) continue;
-      double until = 0.0;
-      const int verdict =
-          locator_.certify_departure(poly_, start_, j, tol, 1.0, settings_.min_width, &until);
-      if (verdict < 0) {
-        flip_.push_back(j);
-      } else {
-        settings_.certified_until[j] = until;
-        if (verdict == 0) settings_.tolerance[j] = tol;
-      }
-    }
-    return !flip_.empty();
   }
 
   void step() {
@@ -487,7 +337,8 @@ class BandedStepper final : public SwitchingPim {
     taylor(t, eta_, d_ + 1, 0.0, false);
     if (o_.locate_switches && screen_fails()) {
       ++diagnostics_.screened;
-      switching_step(t);
+      lcp_synced_ = false;
+      switching_step(t, kMethodName);
       return;
     }
     transition_.multiply(state_.data(), bar_.data());
@@ -504,11 +355,7 @@ class BandedStepper final : public SwitchingPim {
       add_forces(correction_[r], correction_columns_[r], ps_[r], bar_);
     }
     const double largest = bar_.cwiseAbs().maxCoeff();
-    if (!(largest <= o_.divergence_bound)) {
-      throw DivergenceError(fmt::format(
-          "the motion blew up at t = {}: largest |x| or |x'| is {} (divergence_bound {})",
-          t + eta_, largest, o_.divergence_bound));
-    }
+    if (!(largest <= o_.divergence_bound)) throw_divergence(t + eta_, largest, o_.divergence_bound);
     if (m_ > 0) {
       for (Index i = 0; i < n_; ++i) half_[i] = bar_[2 * i];
       q_ = spring_offset_;
@@ -525,7 +372,8 @@ class BandedStepper final : public SwitchingPim {
       for (Index j = 0; j < m_; ++j) {
         if ((z_[j] > 0.0) != (mode_[j] > 0.0)) {
           ++diagnostics_.lcp_mismatches;
-          switching_step(t);
+          lcp_synced_ = false;
+      switching_step(t, kMethodName);
           return;
         }
       }
@@ -545,82 +393,6 @@ class BandedStepper final : public SwitchingPim {
     finish_step();
   }
 
-  // True when some gap polynomial might reach zero on the step (switching_pim.cpp).
-  bool screen_fails() const {
-    for (Index j = 0; j < m_; ++j) {
-      const double e0 = signs_[j] * (gw_[0][j] - gaps_[j]);
-      const double e1 = signs_[j] * gw_[1][j];
-      double rest = 0.0;
-      for (int r = 2; r <= d_ + 1; ++r) rest += std::abs(gw_[static_cast<std::size_t>(r)][j]);
-      if (!(e0 > 0.0 && e0 + e1 - rest > 0.0)) return true;
-    }
-    return false;
-  }
-
-  // The step redone in pieces, each following the Taylor series of the current mode (sparse
-  // products, the whole state) up to the first located switch or the end of the step. On entry
-  // xs_[0], us_[0] hold the step's start and the series up to order d_ + 1 is in the buffers.
-  void switching_step(double t0) {
-    ++diagnostics_.switching_steps;
-    lcp_synced_ = false;
-    double s = 0.0;
-    int guard = 0;
-    int resume = d_;
-    while (s < eta_) {
-      if (++guard > 10000) {
-        throw DivergenceError(fmt::format(
-            "pim-switching-banded: more than 10000 pieces in the step at t = {}: the springs "
-            "chatter at their kinks",
-            t0));
-      }
-      double h = eta_ - s;
-      bool whole = true;
-      int R = 0;
-      collect_acting();
-      while (true) {
-        R = taylor(t0 + s, h, o_.max_series_terms, 0.5 * kEpsilon, true, resume);
-        resume = 0;
-        if (R < o_.max_series_terms) break;
-        h *= 0.5;
-        whole = false;
-        if (!(h > 0.0)) {
-          throw DivergenceError("pim-switching-banded: the Taylor series did not converge");
-        }
-      }
-      ++diagnostics_.pieces;
-      if (prepare_polynomial(R)) {
-        // A spring on its kink whose motion points to the other side: correct its mode (not a
-        // switch) and start the new mode's series from the same point.
-        for (Index j : flip_) set_mode(j, !(mode_[j] > 0.0));
-        continue;
-      }
-      const event_detail::SearchResult& r =
-          locator_.find_first_crossing(poly_, start_, 1.0, settings_);
-      diagnostics_.gap_samples += r.samples;
-      if (r.found) {
-        evaluate_series(R, r.at.t);
-        s = r.at.t >= 1.0 && whole ? eta_ : s + r.at.t * h;
-        for (Index j : r.springs) toggle(j);
-      } else {
-        evaluate_series(R, 1.0);
-        s = whole ? eta_ : s + h;
-      }
-      xs_[0].swap(vx_);
-      us_[0].swap(vu_);
-    }
-    for (Index i = 0; i < n_; ++i) {
-      state_[2 * i] = xs_[0][i];
-      state_[2 * i + 1] = us_[0][i];
-    }
-    finish_step();
-  }
-
-  void toggle(Index j) {
-    set_mode(j, !(mode_[j] > 0.0));
-    ++diagnostics_.switches;
-    ++stats_.kink_events;
-  }
-
   void finish_step() {
     ++steps_;
     ++stats_.steps;
@@ -633,11 +405,7 @@ class BandedStepper final : public SwitchingPim {
       if (std::isnan(x) || std::isnan(v)) largest = std::numeric_limits<double>::infinity();
     }
     x_scale_ = std::max(x_scale_, largest_x);
-    if (!(largest <= o_.divergence_bound)) {
-      throw DivergenceError(fmt::format(
-          "the motion blew up at t = {}: largest |x| or |x'| is {} (divergence_bound {})",
-          time(), largest, o_.divergence_bound));
-    }
+    if (!(largest <= o_.divergence_bound)) throw_divergence(time(), largest, o_.divergence_bound);
   }
 
   SwitchingPimOptions o_;
@@ -656,12 +424,10 @@ class BandedStepper final : public SwitchingPim {
   RowSparse stiffness_part_, damping_part_, force_part_, gap_rows_, spring_rows_;
   Vector gaps_, stiffnesses_, spring_offset_, abs_row_sums_;
   std::vector<LoadTerm> loads_;
-  double phase_sin_[16] = {}, phase_cos_[16] = {}, load_scale_[16] = {};
 
-  std::vector<Vector> xs_, us_, ps_, gw_;
   std::vector<int> acting_;
   Vector mode_, signs_;
-  Vector state_, bar_, acc_, half_, vx_, vu_;
+  Vector state_, bar_, half_;
   Vector z_, q_, slope_guess_;
   double origin_ = 0.0;
   long steps_ = 0;
@@ -669,11 +435,6 @@ class BandedStepper final : public SwitchingPim {
   Vector position_, velocity_;
   IntegratorStats stats_;
   SwitchingPimDiagnostics diagnostics_;
-  PolynomialGaps poly_;
-  event_detail::EventLocator locator_;
-  GapSample start_;
-  event_detail::SearchSettings settings_;
-  std::vector<Index> flip_;
 };
 
 }  // namespace

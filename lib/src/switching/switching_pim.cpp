@@ -15,7 +15,9 @@
 #include "switching/switching_pim_detail.hpp"
 #include "pwl/errors.hpp"
 #include "integrators/fixed_step_count.hpp"
+#include "pwl/numerics/block_pivoting.hpp"
 #include "pwl/numerics/lcp_solver.hpp"
+#include "pwl/numerics/state_checks.hpp"
 #include "pwl/integrators/pim_step_operators.hpp"
 
 namespace pwl {
@@ -122,10 +124,7 @@ PolynomialForceIntegrals polynomial_force_integrals(const Matrix& H, double eta,
 
 namespace {
 
-using event_detail::GapSample;
-constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
-
-using switching_detail::PolynomialGaps;
+using switching_detail::kEpsilon;
 
 struct LoadTerm {
   double omega;
@@ -138,7 +137,7 @@ struct Operators {
   double eta = 0.0;
   int degree = 0;
   Matrix transition;
-  std::vector<Matrix> correction;  // the coefficient of p_r, r = 0..d
+  std::vector<Matrix> correction;  // the coefficient of p_r (switching_detail::force_coefficients)
   Matrix phi;                      // the coefficient of P_{k+1}
   Matrix slope;                    // the coefficient of η P'_{k+1} (end_derivative)
   bool end_derivative = false;
@@ -192,24 +191,11 @@ Operators make_operators(const GapStructure& structure, const SwitchingPimOption
   const PolynomialForceIntegrals pfi = polynomial_force_integrals(
       state_matrix(structure), o.step, G, d + (o.end_derivative ? 2 : 1), o.exponential);
   ops.transition = pfi.transition;
-  const auto moment = [&](int r) -> const Matrix& { return pfi.moments[static_cast<std::size_t>(r)]; };
-  if (!o.end_derivative) {
-    // P(σ) = Σ_{r<=d} p_r σ^r + (P_end - Σ p_r) σ^{d+1}.
-    ops.phi = moment(d + 1);
-    for (int r = 0; r <= d; ++r) ops.correction.push_back(moment(r) - ops.phi);
-    ops.slope = Matrix::Zero(2 * n, m);
-  } else {
-    // P(σ) = Σ_{r<=d} p_r σ^r + α σ^{d+1} + β σ^{d+2} with P(1) = P_end and P'(1) = q_end
-    // (η P' at the end): β = q_end - Σ r p_r - (d+1)(P_end - Σ p_r), α = P_end - Σ p_r - β,
-    // so with Δ = Ξ̂_{d+2} - Ξ̂_{d+1} the step is Σ_r (Ξ̂_r - Ξ̂_{d+1} + (d+1-r) Δ) p_r
-    // + (Ξ̂_{d+1} - (d+1) Δ) P_end + Δ q_end.
-    const Matrix delta = moment(d + 2) - moment(d + 1);
-    ops.phi = moment(d + 1) - (d + 1) * delta;
-    for (int r = 0; r <= d; ++r) {
-      ops.correction.push_back(moment(r) - moment(d + 1) + (d + 1 - r) * delta);
-    }
-    ops.slope = delta;
-  }
+  switching_detail::ForceCoefficients c =
+      switching_detail::force_coefficients(pfi.moments, d, o.end_derivative);
+  ops.correction = std::move(c.correction);
+  ops.phi = std::move(c.phi);
+  ops.slope = std::move(c.slope);
   // The harmonic responses are the plain PIM's (exact for any step).
   ops.harmonics = make_pim_step_operators(structure, o.step, o.exponential).harmonics;
   ops.lcp_matrix = Matrix::Identity(m, m) -
@@ -218,11 +204,27 @@ Operators make_operators(const GapStructure& structure, const SwitchingPimOption
 }
 
 template <int Dofs, int Springs>
-class Stepper final : public SwitchingPim {
+class Stepper final
+    : public SwitchingPim,
+      private switching_detail::ModeSeries<Stepper<Dofs, Springs>, Eigen::Matrix<double, Dofs, 1>,
+                                           Eigen::Matrix<double, Springs, 1>> {
   static constexpr int kState = Dofs == Eigen::Dynamic ? Eigen::Dynamic : 2 * Dofs;
   using State = Eigen::Matrix<double, kState, 1>;
   using Half = Eigen::Matrix<double, Dofs, 1>;
   using Force = Eigen::Matrix<double, Springs, 1>;
+  using Series = switching_detail::ModeSeries<Stepper, Half, Force>;
+  friend Series;
+  using Series::gw_;
+  using Series::phase_cos_;
+  using Series::phase_sin_;
+  using Series::ps_;
+  using Series::screen_fails;
+  using Series::size_series;
+  using Series::switching_step;
+  using Series::taylor;
+  using Series::us_;
+  using Series::xs_;
+  static constexpr const char* kMethodName = "pim-switching";
   using StateSquare = Eigen::Matrix<double, kState, kState>;
   using StateForce = Eigen::Matrix<double, kState, Springs>;
   using HalfSquare = Eigen::Matrix<double, Dofs, Dofs>;
@@ -240,12 +242,6 @@ class Stepper final : public SwitchingPim {
     }
     transition_ = ops.transition;
     for (const Matrix& c : ops.correction) correction_.push_back(c);
-    if (ops.end_derivative) {
-      // The predicted end slope Σ_{r=1}^{d+1} r p_r enters through slope; fold it into the
-      // coefficients of the p_r (and one more for p_{d+1}).
-      for (int r = 1; r <= d_; ++r) correction_[static_cast<std::size_t>(r)] += r * ops.slope;
-      correction_.push_back((d_ + 1) * ops.slope);
-    }
     phi_ = ops.phi;
     slope_ = ops.slope;
     end_derivative_ = ops.end_derivative;
@@ -284,10 +280,7 @@ class Stepper final : public SwitchingPim {
     }
     phases_ = Phases(0.0, 0.0, 1.0);
     const int terms = std::max(o.max_series_terms, d_ + 2) + 1;
-    xs_.assign(static_cast<std::size_t>(terms), Half::Zero(n_));
-    us_.assign(static_cast<std::size_t>(terms), Half::Zero(n_));
-    ps_.assign(static_cast<std::size_t>(terms), Force::Zero(m_));
-    gw_.assign(static_cast<std::size_t>(terms), Force::Zero(m_));
+    size_series(static_cast<std::size_t>(terms), n_, m_);
     mode_ = Force::Zero(m_);
     signs_ = Force::Constant(m_, -1.0);
     state_ = State::Zero(2 * n_);
@@ -316,13 +309,7 @@ class Stepper final : public SwitchingPim {
   SwitchingPimDiagnostics diagnostics() const override { return diagnostics_; }
 
   void set_state(double t, const Vector& x, const Vector& v) override {
-    if (x.size() != n_ || v.size() != n_) {
-      throw InputError(fmt::format("state has {} displacements and {} velocities, expected {}",
-                                   x.size(), v.size(), n_));
-    }
-    if (!std::isfinite(t) || !x.allFinite() || !v.allFinite()) {
-      throw InputError(fmt::format("initial state at t = {} has a non-finite entry", t));
-    }
+    check_initial_state(t, x, v, n_);
     origin_ = t;
     steps_ = 0;
     state_.head(n_) = x;
@@ -337,15 +324,13 @@ class Stepper final : public SwitchingPim {
   }
 
   void advance_to(double t_end, const StepObserver& observer) override {
-    const long count = detail::fixed_step_count(t_end, time(), eta_);
-    for (long k = 0; k < count; ++k) {
-      step();
-      if (observer) {
-        sync();
-        observer(time(), position_, velocity_);
-      }
-    }
-    sync();
+    detail::advance_on_grid(
+        t_end, time(), eta_, observer, position_, velocity_,
+        [this] {
+          step();
+          return time();
+        },
+        [this] { sync(); });
   }
 
  private:
@@ -430,122 +415,29 @@ class Stepper final : public SwitchingPim {
     velocity_ = state_.tail(n_);
   }
 
-  // Scaled Taylor coefficients of the motion in the current mode about time t for a step h:
-  // xs_[r] = x^{(r)} h^r / r!, us_[r] the same for x', ps_[r] = P^{(r)} h^r / r!, gw_[r] =
-  // W^T xs_[r]. Computes xs_ and gw_ up to `last`, us_ and ps_ up to last - 1. When tol > 0,
-  // stops early once two consecutive terms are below tol times the largest; returns the index
-  // of the last term computed.
-  // With first > 0 the terms up to `first` (velocity and force up to first - 1) are those of
-  // a call with the same t, h and v that stopped there, and the series continues from them.
-  int taylor(double t, double h, const State& v, int last, double tol, bool full = true,
-             int first = 0) {
-    double largest = 0.0;
-    if (first == 0) {
-      xs_[0] = upper(v, n_);
-      us_[0] = lower(v, n_);
-      gw_[0].noalias() = mul(gap_rows_, xs_[0]);
-      for (std::size_t g = 0; g < loads_.size(); ++g) {
-        phase_sin_[g] = std::sin(loads_[g].omega * t);
-        phase_cos_[g] = std::cos(loads_[g].omega * t);
-        load_scale_[g] = 1.0;
-      }
-    }
-    for (int r = 0; r < first; ++r) {
-      largest = std::max({largest, xs_[static_cast<std::size_t>(r)].cwiseAbs().maxCoeff(),
-                          us_[static_cast<std::size_t>(r)].cwiseAbs().maxCoeff()});
-    }
-    largest = std::max({largest, xs_[static_cast<std::size_t>(first)].cwiseAbs().maxCoeff(),
-                        first == 0 ? us_[0].cwiseAbs().maxCoeff() : 0.0});
-    double previous = largest;
-    for (int r = first; r < last; ++r) {
-      const auto ru = static_cast<std::size_t>(r);
-      ps_[ru] = mode_.cwiseProduct(stiffnesses_.cwiseProduct(gw_[ru]));
-      if (r == 0) ps_[ru] -= mode_.cwiseProduct(spring_offset_);
-      const double f = h / (r + 1);
-      xs_[ru + 1] = f * us_[ru];
-      gw_[ru + 1].noalias() = mul(gap_rows_, xs_[ru + 1]);
-      if (!full && r + 1 == last) break;  // the last velocity term is not needed
-      Half acc = mul(stiffness_part_, xs_[ru]);
-      acc.noalias() += mul(damping_part_, us_[ru]);
-      acc.noalias() += mul(force_part_, ps_[ru]);
-      for (std::size_t g = 0; g < loads_.size(); ++g) {
-        // d^r/dt^r of sin and cos at ωt, scaled by (ωh)^r / r!: the cycle (S, C, -S, -C).
-        const double S = phase_sin_[g], C = phase_cos_[g];
-        double ds = 0.0, dc = 0.0;
-        switch (r % 4) {
-          case 0: ds = S; dc = C; break;
-          case 1: ds = C; dc = -S; break;
-          case 2: ds = -S; dc = -C; break;
-          default: ds = -C; dc = S; break;
-        }
-        const double scale = load_scale_[g];
-        if (scale != 0.0) acc += scale * (ds * loads_[g].sin_part + dc * loads_[g].cos_part);
-        load_scale_[g] = scale * loads_[g].omega * h / (r + 1);
-      }
-      us_[ru + 1] = f * acc;
-      if (tol > 0.0) {
-        const double size =
-            std::max(xs_[ru + 1].cwiseAbs().maxCoeff(), us_[ru + 1].cwiseAbs().maxCoeff());
-        largest = std::max(largest, size);
-        if (r + 1 >= 4 && size + previous <= tol * largest) return r + 1;
-        previous = size;
-      }
-    }
-    return last;
+  // The hooks of ModeSeries (switching_pim_detail.hpp), which holds the Taylor recursion and the
+  // pieces of switching steps.
+  void gap_product(const Half& x, Force& out) const { out.noalias() = mul(gap_rows_, x); }
+  void acceleration(const Half& x, const Half& u, const Force& p, Half& acc) const {
+    acc.noalias() = mul(stiffness_part_, x);
+    acc.noalias() += mul(damping_part_, u);
+    acc.noalias() += mul(force_part_, p);
   }
-
-  // Σ_r a_r σ^r for the state.
-  void evaluate_series(int R, double sigma, State& v) const {
-    Half x = xs_[static_cast<std::size_t>(R)];
-    Half u = us_[static_cast<std::size_t>(R)];
-    for (int r = R - 1; r >= 0; --r) {
-      x = x * sigma + xs_[static_cast<std::size_t>(r)];
-      u = u * sigma + us_[static_cast<std::size_t>(r)];
-    }
-    upper(v, n_) = x;
-    lower(v, n_) = u;
-  }
-
-  double kink_tolerance(Index j, const State& v) const {
+  double kink_tolerance(Index j) const {
     return 64.0 * kEpsilon *
-           (std::abs(gaps_[j]) + abs_gap_rows_.row(j).dot(v.head(n_).cwiseAbs()) +
+           (std::abs(gaps_[j]) + abs_gap_rows_.row(j).dot(xs_[0].head(n_).cwiseAbs()) +
             abs_gap_rows_.row(j).sum() * x_scale_);
   }
+  void begin_piece() {}
+  void end_pieces() {
+    upper(state_, n_) = xs_[0];
+    lower(state_, n_) = us_[0];
+  }
 
-  // The gap polynomial of the coefficients gw_[0..R] (mode-signed) on σ in [0, 1]; settles the
-  // springs on their kink at σ = 0. Returns true when a spring must switch at σ = 0 (its
-  // first derivative points away from its mode); fills certified_until_ and tolerance_.
-  bool prepare_polynomial(int R, const State& v) {
-    poly_.c.resize(m_, R + 1);
-    for (int r = 0; r <= R; ++r) {
-      const Force col = signs_.cwiseProduct(gw_[static_cast<std::size_t>(r)] -
-                                            (r == 0 ? gaps_ : Force(Force::Zero(m_))));
-      poly_.c.col(r) = col;
-    }
-    start_ = GapSample();
-    poly_.sample(start_, 0.0, start_);
-    // The bounds of a polynomial are tight: try the whole piece at once and split only where
-    // the envelopes cannot decide.
-    settings_.nominal_spacing = 1.0;
-    settings_.max_spacing = 0.0;
-    settings_.min_width = 64.0 * kEpsilon;
-    settings_.tolerance = Vector::Zero(m_);
-    settings_.certified_until = Vector::Constant(m_, -std::numeric_limits<double>::infinity());
-    flip_.clear();
-    for (Index j = 0; j < m_; ++j) {
-      const double tol = kink_tolerance(j, v);
-      if (start_.e[j] > tol) continue;
-      double until = 0.0;
-      const int verdict =
-          locator_.certify_departure(poly_, start_, j, tol, 1.0, settings_.min_width, &until);
-      if (verdict < 0) {
-        flip_.push_back(j);
-      } else {
-        settings_.certified_until[j] = until;
-        if (verdict == 0) settings_.tolerance[j] = tol;
-      }
-    }
-    return !flip_.empty();
+  // The series of the step from the current state: its start in xs_[0], us_[0].
+  void start_series() {
+    xs_[0] = upper(state_, n_);
+    us_[0] = lower(state_, n_);
   }
 
   // One step. With fixed sizes and at most one load group, the smooth step uses the operators
@@ -576,8 +468,9 @@ class Stepper final : public SwitchingPim {
     }
     if (o_.locate_switches && screen_fails()) {
       ++diagnostics_.screened;
-      taylor(t, eta_, state_, d_ + 1, 0.0, false);  // the data switching_step() continues
-      switching_step(t);
+      start_series();  // the data switching_step() continues
+      taylor(t, eta_, d_ + 1, 0.0, false);
+      switching_step(t, kMethodName);
       return;
     }
     bar_.noalias() = mul(op.bar, state_);
@@ -600,8 +493,9 @@ class Stepper final : public SwitchingPim {
       for (Index j = 0; j < m_; ++j) {
         if ((z_[j] > 0.0) != (mode_[j] > 0.0)) {
           ++diagnostics_.lcp_mismatches;
-          taylor(t, eta_, state_, d_ + 1, 0.0, false);
-          switching_step(t);
+          start_series();
+          taylor(t, eta_, d_ + 1, 0.0, false);
+          switching_step(t, kMethodName);
           return;
         }
       }
@@ -627,10 +521,10 @@ class Stepper final : public SwitchingPim {
 
   // The LCP for q_ when the block-pivoting solver's first iterate from the warm start (the
   // current mode) already solves it, as it does in every smooth step: z = 0 when q is
-  // non-negative, else x = T_A q with the mode's transform. The same test and tolerances as the
-  // solver (lcp_solver.cpp), without its input checks and the virtual call. Returns false
-  // (z_ untouched) when it cannot decide: another solver, a non-finite q, or an infeasible
-  // iterate, which the solver then pivots away.
+  // non-negative, else x = T_A q with the mode's transform. The first iteration of
+  // block_pivoting.hpp with the solver's tolerances, without its input checks and the virtual
+  // call. Returns false (z_ untouched) when it cannot decide: another solver, a non-finite q, or
+  // an infeasible iterate, which the solver then pivots away.
   bool solve_warm(const ModeOps& op) {
     if (!inline_lcp_ || !op.lcp_ready) return false;
     double qmax = 0.0, qmin = std::numeric_limits<double>::infinity();
@@ -640,17 +534,15 @@ class Stepper final : public SwitchingPim {
       qmax = std::max(qmax, std::abs(v));
       qmin = std::min(qmin, v);
     }
-    const double tol_w = kLcpFeasTol * qmax;
-    const double tol_z = tol_w / lcp_scale_;
-    if (qmin >= -tol_w) {  // z = 0 solves it
+    const block_pivoting::Tolerances tol = block_pivoting::tolerances(qmax, lcp_scale_);
+    if (block_pivoting::zero_solves(qmin, tol)) {
       z_.setZero();
       return true;
     }
     lcp_x_.noalias() = mul(op.lcp_transform, q_);
-    for (Index i = 0; i < m_; ++i) {
-      const double tol = mode_[i] > 0.0 ? tol_z : tol_w;
-      if (lcp_x_[i] < -tol) return false;
-    }
+    block_pivoting::MaskedActiveSet set;
+    set.mask = static_cast<std::uint32_t>(mode_mask_);
+    if (set.mark_infeasible(lcp_x_, static_cast<int>(m_), tol) != 0) return false;
     for (Index i = 0; i < m_; ++i) z_[i] = mode_[i] > 0.0 ? std::max(lcp_x_[i], 0.0) : 0.0;
     return true;
   }
@@ -658,12 +550,13 @@ class Stepper final : public SwitchingPim {
   void step_direct() {
     const double t = time();
     // Taylor data of the force over the step (and one more gap term for the screen).
-    taylor(t, eta_, state_, d_ + 1, 0.0, false);
+    start_series();
+    taylor(t, eta_, d_ + 1, 0.0, false);
     if (o_.locate_switches && screen_fails()) {
       // A spring may switch in this step: follow it with the series, which locates the switch
       // if there is one and is exact to rounding either way.
       ++diagnostics_.screened;
-      switching_step(t);
+      switching_step(t, kMethodName);
       return;
     }
     bar_.noalias() = mul(transition_, state_);
@@ -686,7 +579,7 @@ class Stepper final : public SwitchingPim {
       for (Index j = 0; j < m_; ++j) {
         if ((z_[j] > 0.0) != (mode_[j] > 0.0)) {
           ++diagnostics_.lcp_mismatches;
-          switching_step(t);
+          switching_step(t, kMethodName);
           return;
         }
       }
@@ -703,77 +596,6 @@ class Stepper final : public SwitchingPim {
     finish_step();
   }
 
-  // True when some gap polynomial might reach zero on the step. On σ in [0, 1],
-  // e(σ) >= e_0 + e_1 σ - S σ² with S the sum of |e_r| for r >= 2; that concave lower bound is
-  // positive on [0, 1] when it is positive at both ends.
-  bool screen_fails() const {
-    for (Index j = 0; j < m_; ++j) {
-      const double e0 = signs_[j] * (gw_[0][j] - gaps_[j]);
-      const double e1 = signs_[j] * gw_[1][j];
-      double rest = 0.0;
-      for (int r = 2; r <= d_ + 1; ++r) rest += std::abs(gw_[static_cast<std::size_t>(r)][j]);
-      if (!(e0 > 0.0 && e0 + e1 - rest > 0.0)) return true;
-    }
-    return false;
-  }
-
-  // The step redone in pieces: each piece follows the Taylor series of the current mode up to
-  // the first located switch, or to the end of the step.
-  // On entry the Taylor data of the whole step (up to order d_ + 1, from step()) are in the
-  // buffers; the first piece continues that series instead of starting again.
-  void switching_step(double t0) {
-    ++diagnostics_.switching_steps;
-    State v = state_;
-    double s = 0.0;
-    int guard = 0;
-    int resume = d_;
-    while (s < eta_) {
-      if (++guard > 10000) {
-        throw DivergenceError(fmt::format(
-            "pim-switching: more than 10000 pieces in the step at t = {}: the springs chatter "
-            "at their kinks",
-            t0));
-      }
-      double h = eta_ - s;
-      bool whole = true;
-      int R = 0;
-      while (true) {
-        R = taylor(t0 + s, h, v, o_.max_series_terms, 0.5 * kEpsilon, true, resume);
-        resume = 0;
-        if (R < o_.max_series_terms) break;
-        h *= 0.5;
-        whole = false;
-        if (!(h > 0.0)) throw DivergenceError("pim-switching: the Taylor series did not converge");
-      }
-      ++diagnostics_.pieces;
-      if (prepare_polynomial(R, v)) {
-        // A spring on its kink whose motion points to the other side: its mode was a guess (a
-        // start exactly at the kink) or it only touched; correct it, not counted as a switch.
-        for (Index j : flip_) set_mode(j, !(mode_[j] > 0.0));
-        continue;  // the new mode's series from the same point
-      }
-      const event_detail::SearchResult& r =
-          locator_.find_first_crossing(poly_, start_, 1.0, settings_);
-      diagnostics_.gap_samples += r.samples;
-      if (r.found) {
-        evaluate_series(R, r.at.t, v);
-        s = r.at.t >= 1.0 && whole ? eta_ : s + r.at.t * h;
-        for (Index j : r.springs) toggle(j);
-      } else {
-        evaluate_series(R, 1.0, v);
-        s = whole ? eta_ : s + h;
-      }
-    }
-    state_ = v;
-    finish_step();
-  }
-
-  void toggle(Index j) {
-    set_mode(j, !(mode_[j] > 0.0));
-    ++diagnostics_.switches;
-    ++stats_.kink_events;
-  }
-
   void finish_step() {
     ++steps_;
     ++stats_.steps;
@@ -781,11 +603,7 @@ class Stepper final : public SwitchingPim {
     advance_phases();
     const double largest = state_.cwiseAbs().maxCoeff();
     x_scale_ = std::max(x_scale_, upper(state_, n_).cwiseAbs().maxCoeff());
-    if (!(largest <= o_.divergence_bound)) {
-      throw DivergenceError(fmt::format(
-          "the motion blew up at t = {}: largest |x| or |x'| is {} (divergence_bound {})",
-          time(), largest, o_.divergence_bound));
-    }
+    if (!(largest <= o_.divergence_bound)) throw_divergence(time(), largest, o_.divergence_bound);
   }
 
   // sin ωt and cos ωt of the load group (the per-mode path takes at most one) at the step
@@ -896,37 +714,9 @@ class Stepper final : public SwitchingPim {
     out->slope_rows = eta_ * touching.asDiagonal() * W_t;
 
     // The LCP transform of the mode as active set: x = T_A q with z_A = -M_AA⁻¹ q_A and
-    // w_F = q_F - M_FA M_AA⁻¹ q_A.
-    std::vector<Index> active;
-    for (Index j = 0; j < m; ++j)
-      if (mode_[j] > 0.0) active.push_back(j);
-    const auto k = static_cast<Index>(active.size());
-    const auto at = [&](Index a) { return active[static_cast<std::size_t>(a)]; };
-    Matrix block(k, k);
-    for (Index a = 0; a < k; ++a)
-      for (Index b = 0; b < k; ++b) block(a, b) = lcp_matrix_(at(a), at(b));
-    Matrix inverse = Matrix::Identity(k, k);
-    out->lcp_ready = true;
-    if (k > 0) {
-      const Eigen::FullPivLU<Matrix> lu(block);
-      if (lu.isInvertible()) {
-        inverse = lu.inverse();
-      } else {
-        out->lcp_ready = false;  // the solver reports it
-      }
-    }
-    Matrix transform = Matrix::Zero(m, m);
-    for (Index a = 0; a < k; ++a)
-      for (Index b = 0; b < k; ++b) transform(at(a), at(b)) = -inverse(a, b);
-    for (Index i = 0; i < m; ++i) {
-      if (mode_[i] > 0.0) continue;
-      transform(i, i) = 1.0;
-      for (Index b = 0; b < k; ++b) {
-        double sum = 0.0;
-        for (Index a = 0; a < k; ++a) sum += lcp_matrix_(i, at(a)) * inverse(a, b);
-        transform(i, at(b)) = -sum;
-      }
-    }
+    // w_F = q_F - M_FA M_AA⁻¹ q_A; a singular M_AA is left to the solver, which reports it.
+    Matrix transform;
+    out->lcp_ready = block_pivoting::active_set_transform(lcp_matrix_, m, mode_mask_, transform);
     out->lcp_transform = transform;
     return out;
   }
@@ -935,7 +725,6 @@ class Stepper final : public SwitchingPim {
   static constexpr bool kModeCache = Dofs != Eigen::Dynamic && Springs != Eigen::Dynamic;
   static constexpr Index kMaxCachedSprings = 6;
   static constexpr long kReanchorSteps = 256;
-  static constexpr double kLcpFeasTol = 1e-11;  // as in lcp_solver.cpp: relative to |q|_inf
 
   SwitchingPimOptions o_;
   Index n_, m_;
@@ -954,10 +743,7 @@ class Stepper final : public SwitchingPim {
   ForceHalf gap_rows_, spring_rows_, abs_gap_rows_;
   Force gaps_, stiffnesses_, spring_offset_;
   std::vector<Load> loads_;
-  double phase_sin_[16] = {}, phase_cos_[16] = {}, load_scale_[16] = {};
 
-  std::vector<Half> xs_, us_;
-  std::vector<Force> ps_, gw_;
   Force mode_, signs_;
   State state_, bar_;
   Force z_, w_, q_;
@@ -967,11 +753,6 @@ class Stepper final : public SwitchingPim {
   Vector position_, velocity_;
   IntegratorStats stats_;
   SwitchingPimDiagnostics diagnostics_;
-  PolynomialGaps poly_;
-  event_detail::EventLocator locator_;
-  GapSample start_;
-  event_detail::SearchSettings settings_;
-  std::vector<Index> flip_;
 
   Matrix lcp_matrix_;
   double lcp_scale_ = 1.0;       // max |M_ij| of the LCP matrix

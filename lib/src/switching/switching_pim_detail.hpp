@@ -3,11 +3,19 @@
 // banded_switching_pim.hpp); private to pwl_core.
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <limits>
+#include <vector>
+
+#include <fmt/format.h>
 
 #include "event/event_location.hpp"
+#include "pwl/errors.hpp"
 #include "pwl/types.hpp"
 
 namespace pwl::switching_detail {
+
+inline constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
 
 // The gap functions of one piece of a switching step as polynomials in σ = s/h on [0, 1]:
 // e_j(σ) = Σ_r c(j, r) σ^r (mode-signed).
@@ -102,4 +110,274 @@ class PolynomialGaps final : public event_detail::ModeGaps {
     }
   }
 };
+
+// The coefficients of the step's force polynomial from the moments Ξ̂_0 .. Ξ̂_{d+1} (Ξ̂_{d+2} with
+// the end slope) of polynomial_force_integrals: correction[r] multiplies p_r (with the end slope,
+// the predicted slope Σ r p_r folded in, and one more for p_{d+1}), phi multiplies P_{k+1},
+// slope the correction of η P'_{k+1}. For the dense operators and for each substructure of the
+// banded ones.
+struct ForceCoefficients {
+  std::vector<Matrix> correction;
+  Matrix phi, slope;
+};
+
+inline ForceCoefficients force_coefficients(const std::vector<Matrix>& moments, int d, bool end) {
+  const auto moment = [&](int r) -> const Matrix& { return moments[static_cast<std::size_t>(r)]; };
+  ForceCoefficients c;
+  if (!end) {
+    // P(σ) = Σ_{r<=d} p_r σ^r + (P_end - Σ p_r) σ^{d+1}.
+    c.phi = moment(d + 1);
+    for (int r = 0; r <= d; ++r) c.correction.push_back(moment(r) - c.phi);
+    c.slope = Matrix::Zero(c.phi.rows(), c.phi.cols());
+    return c;
+  }
+  // P(σ) = Σ_{r<=d} p_r σ^r + α σ^{d+1} + β σ^{d+2} with P(1) = P_end and P'(1) = q_end
+  // (η P' at the end): β = q_end - Σ r p_r - (d+1)(P_end - Σ p_r), α = P_end - Σ p_r - β,
+  // so with Δ = Ξ̂_{d+2} - Ξ̂_{d+1} the step is Σ_r (Ξ̂_r - Ξ̂_{d+1} + (d+1-r) Δ) p_r
+  // + (Ξ̂_{d+1} - (d+1) Δ) P_end + Δ q_end.
+  const Matrix delta = moment(d + 2) - moment(d + 1);
+  c.phi = moment(d + 1) - (d + 1) * delta;
+  for (int r = 0; r <= d; ++r) c.correction.push_back(moment(r) - moment(d + 1) + (d + 1 - r) * delta);
+  c.slope = delta;
+  // The predicted end slope Σ_{r=1}^{d+1} r p_r enters through slope; fold it into the
+  // coefficients of the p_r (and one more for p_{d+1}).
+  for (int r = 1; r <= d; ++r) c.correction[static_cast<std::size_t>(r)] += r * c.slope;
+  c.correction.push_back((d + 1) * c.slope);
+  return c;
+}
+
+// The Taylor series of the motion in one mode and the pieces of a switching step, for the dense
+// and the banded stepper alike (CRTP: Stepper derives from this and makes it a friend). The two
+// differ only in their storage (fixed-size and dense, or sparse) and in a few hooks:
+//
+//   void gap_product(const Half& x, Force& out);          // out = W^T x
+//   void acceleration(const Half& x, const Half& u, const Force& p, Half& acc);
+//                                                          // acc = -M⁻¹ (K x + C u + W p)
+//   double kink_tolerance(Index j) const;                  // of spring j at the piece start xs_[0]
+//   void begin_piece();                                    // before each piece's series
+//   void set_mode(Index j, bool on);
+//   void end_pieces();                                     // the state from xs_[0], us_[0]
+//   void finish_step();
+//
+// and the data members mode_, signs_, gaps_, stiffnesses_, spring_offset_, loads_ (omega,
+// sin_part, cos_part: M⁻¹ times the load), m_, d_, eta_, o_ (SwitchingPimOptions), diagnostics_
+// and stats_, with the same meaning in both.
+template <class Stepper, class Half, class Force>
+class ModeSeries {
+ protected:
+  Stepper& self() { return static_cast<Stepper&>(*this); }
+  const Stepper& self() const { return static_cast<const Stepper&>(*this); }
+
+  // Sizes the series buffers for `terms` terms, n degrees of freedom and m springs.
+  void size_series(std::size_t terms, Index n, Index m) {
+    xs_.assign(terms, Half::Zero(n));
+    us_.assign(terms, Half::Zero(n));
+    ps_.assign(terms, Force::Zero(m));
+    gw_.assign(terms, Force::Zero(m));
+    vx_ = Half::Zero(n);
+    vu_ = vx_;
+    acc_ = vx_;
+  }
+
+  // Scaled Taylor coefficients of the motion in the current mode about time t for a step h, the
+  // start in xs_[0] and us_[0]: xs_[r] = x^{(r)} h^r / r!, us_[r] the same for x', ps_[r] =
+  // P^{(r)} h^r / r!, gw_[r] = W^T xs_[r]. Computes xs_ and gw_ up to `last`, us_ and ps_ up to
+  // last - 1 (us_[last] too when full). When tol > 0, stops early once two consecutive terms are
+  // below tol times the largest; returns the index of the last term computed. With first > 0 the
+  // terms up to `first` (velocity and force up to first - 1) are those of a call with the same
+  // t, h and start that stopped there, and the series continues from them.
+  int taylor(double t, double h, int last, double tol, bool full = true, int first = 0) {
+    Stepper& st = self();
+    double largest = 0.0;
+    if (first == 0) {
+      st.gap_product(xs_[0], gw_[0]);
+      for (std::size_t g = 0; g < st.loads_.size(); ++g) {
+        phase_sin_[g] = std::sin(st.loads_[g].omega * t);
+        phase_cos_[g] = std::cos(st.loads_[g].omega * t);
+        load_scale_[g] = 1.0;
+      }
+    }
+    for (int r = 0; r < first; ++r) {
+      largest = std::max({largest, xs_[static_cast<std::size_t>(r)].cwiseAbs().maxCoeff(),
+                          us_[static_cast<std::size_t>(r)].cwiseAbs().maxCoeff()});
+    }
+    largest = std::max({largest, xs_[static_cast<std::size_t>(first)].cwiseAbs().maxCoeff(),
+                        first == 0 ? us_[0].cwiseAbs().maxCoeff() : 0.0});
+    double previous = largest;
+    for (int r = first; r < last; ++r) {
+      const auto ru = static_cast<std::size_t>(r);
+      ps_[ru] = st.mode_.cwiseProduct(st.stiffnesses_.cwiseProduct(gw_[ru]));
+      if (r == 0) ps_[ru] -= st.mode_.cwiseProduct(st.spring_offset_);
+      const double f = h / (r + 1);
+      xs_[ru + 1] = f * us_[ru];
+      st.gap_product(xs_[ru + 1], gw_[ru + 1]);
+      if (!full && r + 1 == last) break;  // the last velocity term is not needed
+      st.acceleration(xs_[ru], us_[ru], ps_[ru], acc_);
+      for (std::size_t g = 0; g < st.loads_.size(); ++g) {
+        // d^r/dt^r of sin and cos at ωt, scaled by (ωh)^r / r!: the cycle (S, C, -S, -C).
+        const double S = phase_sin_[g], C = phase_cos_[g];
+        double ds = 0.0, dc = 0.0;
+        switch (r % 4) {
+          case 0: ds = S; dc = C; break;
+          case 1: ds = C; dc = -S; break;
+          case 2: ds = -S; dc = -C; break;
+          default: ds = -C; dc = S; break;
+        }
+        const double scale = load_scale_[g];
+        if (scale != 0.0) acc_ += scale * (ds * st.loads_[g].sin_part + dc * st.loads_[g].cos_part);
+        load_scale_[g] = scale * st.loads_[g].omega * h / (r + 1);
+      }
+      us_[ru + 1] = f * acc_;
+      if (tol > 0.0) {
+        const double size =
+            std::max(xs_[ru + 1].cwiseAbs().maxCoeff(), us_[ru + 1].cwiseAbs().maxCoeff());
+        largest = std::max(largest, size);
+        if (r + 1 >= 4 && size + previous <= tol * largest) return r + 1;
+        previous = size;
+      }
+    }
+    return last;
+  }
+
+  // Σ_r a_r σ^r for the state, into vx_ and vu_.
+  void evaluate_series(int R, double sigma) {
+    vx_ = xs_[static_cast<std::size_t>(R)];
+    vu_ = us_[static_cast<std::size_t>(R)];
+    for (int r = R - 1; r >= 0; --r) {
+      vx_ = vx_ * sigma + xs_[static_cast<std::size_t>(r)];
+      vu_ = vu_ * sigma + us_[static_cast<std::size_t>(r)];
+    }
+  }
+
+  // True when some gap polynomial might reach zero on the step. On σ in [0, 1],
+  // e(σ) >= e_0 + e_1 σ - S σ² with S the sum of |e_r| for r >= 2; that concave lower bound is
+  // positive on [0, 1] when it is positive at both ends.
+  bool screen_fails() const {
+    const Stepper& st = self();
+    for (Index j = 0; j < st.m_; ++j) {
+      const double e0 = st.signs_[j] * (gw_[0][j] - st.gaps_[j]);
+      const double e1 = st.signs_[j] * gw_[1][j];
+      double rest = 0.0;
+      for (int r = 2; r <= st.d_ + 1; ++r) rest += std::abs(gw_[static_cast<std::size_t>(r)][j]);
+      if (!(e0 > 0.0 && e0 + e1 - rest > 0.0)) return true;
+    }
+    return false;
+  }
+
+  // The gap polynomial of the coefficients gw_[0..R] (mode-signed) on σ in [0, 1]; settles the
+  // springs on their kink at σ = 0. Returns true when a spring must switch at σ = 0 (its first
+  // derivative points away from its mode), listed in flip_.
+  bool prepare_polynomial(int R) {
+    const Stepper& st = self();
+    poly_.c.resize(st.m_, R + 1);
+    for (int r = 0; r <= R; ++r) {
+      const auto ru = static_cast<std::size_t>(r);
+      if (r == 0) {
+        poly_.c.col(0) = st.signs_.cwiseProduct(gw_[0] - st.gaps_);
+      } else {
+        poly_.c.col(r) = st.signs_.cwiseProduct(gw_[ru]);
+      }
+    }
+    start_ = event_detail::GapSample();
+    poly_.sample(start_, 0.0, start_);
+    // The bounds of a polynomial are tight: try the whole piece at once and split only where
+    // the envelopes cannot decide.
+    settings_.nominal_spacing = 1.0;
+    settings_.max_spacing = 0.0;
+    settings_.min_width = 64.0 * kEpsilon;
+    settings_.tolerance = Vector::Zero(st.m_);
+    settings_.certified_until = Vector::Constant(st.m_, -std::numeric_limits<double>::infinity());
+    flip_.clear();
+    for (Index j = 0; j < st.m_; ++j) {
+      const double tol = st.kink_tolerance(j);
+      if (start_.e[j] > tol) continue;
+      double until = 0.0;
+      const int verdict =
+          locator_.certify_departure(poly_, start_, j, tol, 1.0, settings_.min_width, &until);
+      if (verdict < 0) {
+        flip_.push_back(j);
+      } else {
+        settings_.certified_until[j] = until;
+        if (verdict == 0) settings_.tolerance[j] = tol;
+      }
+    }
+    return !flip_.empty();
+  }
+
+  // The step redone in pieces: each piece follows the Taylor series of the current mode up to
+  // the first located switch, or to the end of the step. On entry xs_[0], us_[0] hold the step's
+  // start and the series up to order d_ + 1 is in the buffers; the first piece continues that
+  // series instead of starting again. `method` names the stepper in errors.
+  void switching_step(double t0, const char* method) {
+    Stepper& st = self();
+    ++st.diagnostics_.switching_steps;
+    double s = 0.0;
+    int guard = 0;
+    int resume = st.d_;
+    while (s < st.eta_) {
+      if (++guard > 10000) {
+        throw DivergenceError(fmt::format(
+            "{}: more than 10000 pieces in the step at t = {}: the springs chatter at their "
+            "kinks",
+            method, t0));
+      }
+      double h = st.eta_ - s;
+      bool whole = true;
+      int R = 0;
+      st.begin_piece();
+      while (true) {
+        R = taylor(t0 + s, h, st.o_.max_series_terms, 0.5 * kEpsilon, true, resume);
+        resume = 0;
+        if (R < st.o_.max_series_terms) break;
+        h *= 0.5;
+        whole = false;
+        if (!(h > 0.0)) {
+          throw DivergenceError(fmt::format("{}: the Taylor series did not converge", method));
+        }
+      }
+      ++st.diagnostics_.pieces;
+      if (prepare_polynomial(R)) {
+        // A spring on its kink whose motion points to the other side: its mode was a guess (a
+        // start exactly at the kink) or it only touched; correct it, not counted as a switch,
+        // and start the new mode's series from the same point.
+        for (Index j : flip_) st.set_mode(j, !(st.mode_[j] > 0.0));
+        continue;
+      }
+      const event_detail::SearchResult& r =
+          locator_.find_first_crossing(poly_, start_, 1.0, settings_);
+      st.diagnostics_.gap_samples += r.samples;
+      if (r.found) {
+        evaluate_series(R, r.at.t);
+        s = r.at.t >= 1.0 && whole ? st.eta_ : s + r.at.t * h;
+        for (Index j : r.springs) toggle(j);
+      } else {
+        evaluate_series(R, 1.0);
+        s = whole ? st.eta_ : s + h;
+      }
+      xs_[0].swap(vx_);
+      us_[0].swap(vu_);
+    }
+    st.end_pieces();
+    st.finish_step();
+  }
+
+  void toggle(Index j) {
+    Stepper& st = self();
+    st.set_mode(j, !(st.mode_[j] > 0.0));
+    ++st.diagnostics_.switches;
+    ++st.stats_.kink_events;
+  }
+
+  std::vector<Half> xs_, us_;
+  std::vector<Force> ps_, gw_;
+  Half vx_, vu_;  // the state a piece ends in
+  Half acc_;      // scratch of taylor()
+  double phase_sin_[16] = {}, phase_cos_[16] = {}, load_scale_[16] = {};
+  PolynomialGaps poly_;
+  event_detail::EventLocator locator_;
+  event_detail::GapSample start_;
+  event_detail::SearchSettings settings_;
+  std::vector<Index> flip_;
+};
+
 }  // namespace pwl::switching_detail

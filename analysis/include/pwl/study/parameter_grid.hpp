@@ -10,7 +10,7 @@
 //
 // Tasks are spread over OpenMP threads with a dynamic schedule (a chaotic point costs no more
 // than a periodic one, but unbounded ones stop early, so the work per task varies). Each point
-// depends only on its own chain and its initial state, so the results do not depend on the number
+// depends only on its own case and its initial state, so the results do not depend on the number
 // of threads or on the order in which tasks finish; callers that write files sort by id.
 #include <functional>
 #include <map>
@@ -25,8 +25,8 @@ struct GridTask {
   bool continuation = false;  // each point starts from the previous point's final state
 };
 
-// The chain of point `id`.
-using PointChain = std::function<NondimensionalChain(long id)>;
+// The case of point `id`: its structure and forcing period (a NondimensionalChain converts).
+using PointCaseOf = std::function<PointCase(long id)>;
 // Told about every point finished in this run. Called by one thread at a time.
 using PointSink = std::function<void(long id, const PointResult& result)>;
 
@@ -38,7 +38,7 @@ struct GridRun {
 // `done` takes its final state from there (a resumed run continues where the killed one stopped);
 // after a point whose motion blew up (no final state) it restarts from `initial_state`.
 // Exceptions from a point (bad input) are rethrown on the calling thread after the loop.
-void run_grid(const std::vector<GridTask>& tasks, const PointChain& chain_of,
+void run_grid(const std::vector<GridTask>& tasks, const PointCaseOf& case_of,
               const Vector& initial_state, const PointSettings& settings,
               const std::map<long, PointResult>& done, const PointSink& sink,
               const GridRun& run = {});

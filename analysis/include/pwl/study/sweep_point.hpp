@@ -1,64 +1,85 @@
 #pragma once
-// One point of a parameter study: the nondimensional chain at one parameter value, integrated from
-// a given state past its transient, its stroboscopic Poincaré points recorded and its motion
-// classified.
+// The motion-analysis pipeline: one case integrated from a given state past its transient, its
+// stroboscopic Poincaré points recorded and its motion classified. `pwl sweep`, `pwl map` and
+// `pwl analyze` all evaluate their points here, so the same case with the same settings gives the
+// same regime, period, λ1 and K whichever job asks.
 //
-// A bifurcation diagram or a regime map evaluates thousands of these, so a point keeps only what
-// the study needs: the Poincaré points of the chosen state components, a handful of numbers (the
-// regime, its period, λ1 and K of the 0-1 test) and the final state, from which the next point of
-// a continuation starts. The trajectory between Poincaré points is never stored.
+// A bifurcation diagram or a regime map evaluates thousands of points, so a point keeps only what
+// a study needs: the Poincaré points of the chosen state components, its indicators (the regime,
+// its period, λ1 and K of the 0-1 test; indicators.hpp lists them) and the final state, from which
+// the next point of a continuation starts. A caller that wants more (`pwl analyze` writes the
+// trajectory and the full Poincaré points and prints the evidence of the classification) passes a
+// PointObserver, which sees the integrator, every step of the periods it asks for, every recorded
+// Poincaré point and the classification, without a second integration or a second classification.
 //
-// The result depends only on the chain, the initial state and the settings: no clock, no thread,
+// The result depends only on the case, the initial state and the settings: no clock, no thread,
 // no random seed that is not fixed here. That is what makes a serial, a multithreaded, a
 // distributed and a resumed study write identical files.
 #include <limits>
 #include <string>
 #include <vector>
 
-#include "pwl/model/chain_builders.hpp"
+#include "pwl/analysis/motion_classifier.hpp"
+#include "pwl/integrators/integrator.hpp"
+#include "pwl/integrators/method_table.hpp"
+#include "pwl/study/point_model.hpp"
 #include "pwl/types.hpp"
 
 namespace pwl::analysis {
 
-// The parameter of a NondimensionalChain a study varies.
-enum class SweepParameter {
-  theta,      // forcing frequency ratio θ
-  alpha,      // contact stiffness ratio α of every mass
-  zeta,       // damping ratio ζ
-  gap,        // gap Δ̃ of every mass
-  amplitude,  // load scale: Q = value · (the base chain's Q)
+// How λ1 is estimated.
+enum class LyapunovEstimate {
+  // One tangent vector pushed through the integrator's exact tangent map and renormalised every
+  // period (the QR method with one column). A study's default: it costs one extra column.
+  tangent_vector,
+  // The whole tangent frame: the Jacobian of every period, QR method on a seeded random frame
+  // (lyapunov.hpp), λ1 the largest of the spectrum. 2n columns.
+  tangent_frame,
+  // Two nearby trajectories (separation 1e-7, renormalised every period): for methods without a
+  // tangent map (dopri5, rkf78, the exact solver). Costs a second integration of the record.
+  two_trajectories,
 };
 
-// "theta", "alpha", "zeta", "gap", "amplitude".
-std::string parameter_name(SweepParameter parameter);
-// The inverse; also accepts "delta" for the gap. Throws InputError naming the value otherwise.
-SweepParameter parse_sweep_parameter(const std::string& name);
-// A copy of `base` with the parameter set to `value`.
-NondimensionalChain with_parameter(const NondimensionalChain& base, SweepParameter parameter,
-                                   double value);
+// "tangent-vector", "tangent-frame", "two-trajectories".
+std::string lyapunov_estimate_name(LyapunovEstimate estimate);
+// The inverse. Throws InputError naming the value and the accepted names.
+LyapunovEstimate parse_lyapunov_estimate(const std::string& name);
 
 struct PointSettings {
   int transient_periods = 500;  // forcing periods integrated and discarded (>= 0)
   int recorded_periods = 500;   // Poincaré points recorded and classified (>= 1)
-  int steps_per_period = 200;   // PIM steps per forcing period, η = T / steps_per_period
+  // Steps per forcing period of a fixed-grid method (method_traits(m).fixed_grid):
+  // η = T / steps_per_period.
+  int steps_per_period = 200;
   // 0-based state components kept in PointResult::poincare: 0..n-1 are x1..xn, n..2n-1 are
-  // v1..vn. May be empty (a regime map keeps only the classification).
+  // v1..vn. May be empty (a regime map keeps only the indicators).
   std::vector<int> components;
-  int observable = -1;     // component the 0-1 test reads; -1: x of the last mass
-  bool lyapunov = true;    // λ1 from the exact tangent map of the PIM step
-  std::string method = "pim";  // "pim", or "dopri5" (kink-located; λ1 is then not computed)
-  double tolerance = 1e-10;    // dopri5's relative and absolute tolerance
+  int observable = -1;  // component the 0-1 test reads; -1: x of the last degree of freedom
+  bool lyapunov = true;  // compute λ1 (at least 10 recorded periods)
+  // The tangent estimates need a method with an exact tangent map (has_tangent_map()); with one
+  // that has none, λ1 is not computed unless the estimate is two_trajectories.
+  LyapunovEstimate lyapunov_estimate = LyapunovEstimate::tangent_vector;
+  // The method and its settings (method_table.hpp). Its step (fixed-grid methods) and largest
+  // step (adaptive ones: T/8) are set per point from the point's period; see method_for.
+  MethodSettings method;
 
-  // Ceres-style check for a chain of `masses` masses: false with a message naming the field.
-  bool is_valid(int masses, std::string* why) const;
+  // The method's settings for a point of forcing period `period`.
+  MethodSettings method_for(double period) const;
+  // Ceres-style check for a state of 2 `dofs` components: false with a message naming the field.
+  bool is_valid(int dofs, std::string* why) const;
+  // Every setting, one "key = value" per line in a fixed order (part of a study's description).
+  std::string describe() const;
 };
 
 struct PointResult {
-  std::string regime;  // regime_name(...) of the classifier, or "failed" (an unsolvable LCP)
+  // The indicators (indicators.hpp registers each one: its column, its journal token).
+  std::string regime;  // regime_name(...) of the classifier, "unbounded", or "failed" (an
+                       // unsolvable LCP)
   int period = 0;      // k for period-k, 0 otherwise
   double lambda1 = std::numeric_limits<double>::quiet_NaN();  // per forcing period; NaN: none
   double lambda1_error = std::numeric_limits<double>::quiet_NaN();
   double K = std::numeric_limits<double>::quiet_NaN();  // 0-1 test; NaN when not computed
+
   int columns = 0;              // = settings.components.size()
   std::vector<double> poincare; // recorded points x columns, row-major
   Vector final_state;           // [x; v] at the end; empty when the motion blew up or failed
@@ -70,13 +91,30 @@ struct PointResult {
 // 10 quasi-periodic, 11 chaotic, 12 unbounded, 13 uncertain or failed.
 int regime_code(const std::string& regime, int period);
 
-// Integrates `chain` from `initial_state` ([x; v], 2n; the loads start at phase 0) over
+// Hooks into one point's evaluation. Every hook is optional; all are called on the evaluating
+// thread, in the order of the motion.
+class PointObserver {
+ public:
+  virtual ~PointObserver() = default;
+  // Once, with the integrator at the initial state, before the first period.
+  virtual void started(const Integrator& /*integrator*/, const PointCase& /*point*/) {}
+  // Before period k (1-based from the initial state) is integrated: what sees its steps (an
+  // empty observer: nothing).
+  virtual StepObserver steps_of_period(int /*k*/) { return {}; }
+  // Every recorded Poincaré point: period k, t = kT, the full state [x; v].
+  virtual void poincare_point(int /*k*/, double /*t*/, const Vector& /*state*/) {}
+  // Once, when the recorded points are classified (not for an unbounded or failed motion).
+  virtual void classified(const Classification& /*classification*/,
+                          const PointResult& /*result*/) {}
+};
+
+// Integrates `point` from `initial_state` ([x; v], 2n; the loads start at phase 0) over
 // transient_periods + recorded_periods forcing periods and classifies the recorded ones: the period
-// search on the full state, λ1 over the recorded periods (from one tangent vector renormalised
-// every period; the first min(50, recorded/5) periods align it), and K on the observable when at
-// least 100 points are recorded. A motion that blows up is "unbounded" (not an exception).
-// Throws InputError for invalid settings or state.
-PointResult evaluate_point(const NondimensionalChain& chain, const Vector& initial_state,
-                           const PointSettings& settings);
+// search on the full state, λ1 over the recorded periods as settings.lyapunov_estimate says (the
+// first min(50, recorded/5) periods align the tangent vector or frame, the rest are averaged in
+// min(10, ...) blocks), and K on the observable when at least 100 points are recorded. A motion
+// that blows up is "unbounded" (not an exception). Throws InputError for invalid settings or state.
+PointResult evaluate_point(const PointCase& point, const Vector& initial_state,
+                           const PointSettings& settings, PointObserver* observer = nullptr);
 
 }  // namespace pwl::analysis

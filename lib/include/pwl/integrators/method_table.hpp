@@ -38,6 +38,8 @@ struct MethodTraits {
   bool tangent_map;   // exact tangent map of the motion (advance_with_tangent)
   bool adaptive;      // error-controlled step: takes a tolerance
   bool kink_location; // can end a step exactly at every spring switch (locate_kinks)
+  bool locates_switches;  // always ends a step at every spring switch and counts the switches
+                          // (IntegratorStats::kink_events): the switching PIM, the exact solver
   bool lcp;           // solves one LCP per step: takes an LCP algorithm
   bool chooses_form;  // picks its dense or banded form itself, by the structure
   bool banded;        // banded operators: work and memory per step grow like n
@@ -70,6 +72,9 @@ struct MethodSettings {
   double max_step = 0.0;      // adaptive: the largest step (0: no limit)
   LcpAlgorithm lcp = LcpAlgorithm::block_pivoting;  // lcp (dense forms; the banded ones have their own)
   long banded_above = 50;     // chooses_form: banded beyond this many degrees of freedom
+  long band = 0;              // banded forms: a forced band q of the step operators, in degrees
+                              // of freedom (0: the smallest q within the truncation tolerance)
+  int force_degree = 2;       // switching forms: derivatives d of the load used (order d + 3)
 
   // Ceres-style check against the structure it will integrate: false with a message naming the
   // setting and its value (a step that is not positive, a tolerance that is not, a structure
@@ -80,6 +85,11 @@ struct MethodSettings {
 // The method's label with the settings a reader needs to repeat the run: "PIM", "switching PIM",
 // "dopri5, kink-located, tol 1e-10" (for tables, figure legends and study descriptions).
 std::string method_label(const MethodSettings& settings);
+
+// Whether the integrator the settings build ends a step at every spring switch and counts the
+// switches in IntegratorStats::kink_events: a row that always does (locates_switches), or one
+// that can (kink_location) asked to (locate_kinks).
+bool locates_switches(const MethodSettings& settings);
 
 // The integrator the settings name, built for `structure`, its state at rest at t = 0. Throws
 // InputError for invalid settings (the message of is_valid) or a structure the method refuses.

@@ -7,7 +7,6 @@
 // run-time-sized version. Time is kept as t_origin + k η with an integer step count, so that a
 // million steps land on kT exactly rather than accumulating rounding.
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <memory>
 #include <vector>
@@ -18,7 +17,9 @@
 #include <fmt/format.h>
 
 #include "pwl/errors.hpp"
+#include "pwl/numerics/block_pivoting.hpp"
 #include "pwl/numerics/lcp_solver.hpp"
+#include "pwl/numerics/state_checks.hpp"
 #include "pwl/integrators/pim_step_operators.hpp"
 
 namespace pwl {
@@ -83,13 +84,7 @@ class PrecisePropagator {
 
   // Sets time and state; the spring forces follow from x (P = k max(0, g)).
   void set_state(double t, const Eigen::Ref<const Vector>& x, const Eigen::Ref<const Vector>& v) {
-    if (x.size() != n_ || v.size() != n_) {
-      throw InputError(fmt::format("state has {} displacements and {} velocities, expected {}",
-                                   x.size(), v.size(), n_));
-    }
-    if (!std::isfinite(t) || !x.allFinite() || !v.allFinite()) {
-      throw InputError(fmt::format("initial state at t = {} has a non-finite entry", t));
-    }
+    check_initial_state(t, x, v, n_);
     origin_ = t;
     steps_ = 0;
     state_.head(n_) = x;
@@ -140,11 +135,7 @@ class PrecisePropagator {
     ++steps_;
     advance_harmonics();
     const double largest = state_.cwiseAbs().maxCoeff();
-    if (!(largest <= bound_)) {
-      throw DivergenceError(fmt::format(
-          "the motion blew up at t = {}: largest |x| or |x'| is {} (bound {})", time(), largest,
-          bound_));
-    }
+    if (!(largest <= bound_)) throw_divergence(time(), largest, bound_);
   }
 
   // Multiplies `tangent` (2n x p, rows in state order [x; x']) by the Jacobian of the step just
@@ -226,49 +217,23 @@ class PrecisePropagator {
 
  private:
   // A fixed number of springs (up to 12) with the block-pivoting solver: the LCP is solved here,
-  // by the same method as make_block_pivoting_solver() (Júdice & Pires 1994, block principal
-  // pivoting warm-started from the previous active set, with Murty's single pivoting as the
-  // fall-back that terminates on P-matrices), with the same tolerances, on fixed-size storage and
-  // without a virtual call or the solver's input checks, whose inputs are known valid here. The
-  // transform T_A with x = T_A q (z_A = -M_AA⁻¹ q_A, w_F = q_F - M_FA M_AA⁻¹ q_A) is computed once
-  // per active set A met and kept.
+  // by the block principal pivoting of block_pivoting.hpp (Júdice & Pires 1994, warm-started from
+  // the previous active set, with Murty's single pivoting as the fall-back that terminates on
+  // P-matrices) as make_block_pivoting_solver() does, on fixed-size storage and without a virtual
+  // call or the solver's input checks, whose inputs are known valid here. The transform T_A with
+  // x = T_A q (z_A = -M_AA⁻¹ q_A, w_F = q_F - M_FA M_AA⁻¹ q_A) is computed once per active set A
+  // met and kept.
   static constexpr bool kInlineLcp = Springs != Eigen::Dynamic && Springs <= 12;
   static constexpr int kInlineSprings = kInlineLcp ? Springs : 1;
-  static constexpr double kLcpFeasTol = 1e-11;  // as in lcp_solver.cpp: relative to |q|_inf
-  static constexpr int kLcpBlockTries = 3;
   using LcpTransform = Eigen::Matrix<double, kInlineSprings, kInlineSprings, Eigen::RowMajor>;
 
   const LcpTransform& lcp_transform(unsigned mask) {
     LcpTransform& t = transforms_[mask];
     if (transform_ready_[mask]) return t;
-    int ia[kInlineSprings];
-    int k = 0;
-    for (int i = 0; i < kInlineSprings; ++i)
-      if (mask >> i & 1u) ia[k++] = i;
-    Matrix block(k, k);
-    for (int a = 0; a < k; ++a)
-      for (int b = 0; b < k; ++b) block(a, b) = lcp_matrix_(ia[a], ia[b]);
-    Matrix inverse = Matrix::Identity(k, k);
-    if (k > 0) {
-      const Eigen::FullPivLU<Matrix> lu(block);
-      if (!lu.isInvertible()) {
-        throw LcpError(fmt::format("block pivoting: the principal block of the step's LCP matrix "
-                                   "for active-set mask {} is singular (not a P-matrix?)",
-                                   mask));
-      }
-      inverse = lu.inverse();
-    }
-    t.setZero();
-    for (int a = 0; a < k; ++a)
-      for (int b = 0; b < k; ++b) t(ia[a], ia[b]) = -inverse(a, b);
-    for (int i = 0; i < kInlineSprings; ++i) {
-      if (mask >> i & 1u) continue;
-      t(i, i) = 1.0;
-      for (int b = 0; b < k; ++b) {
-        double s = 0.0;
-        for (int a = 0; a < k; ++a) s += lcp_matrix_(i, ia[a]) * inverse(a, b);
-        t(i, ia[b]) = -s;
-      }
+    if (!block_pivoting::active_set_transform(lcp_matrix_, kInlineSprings, mask, t)) {
+      throw LcpError(fmt::format("block pivoting: the principal block of the step's LCP matrix "
+                                 "for active-set mask {} is singular (not a P-matrix?)",
+                                 mask));
     }
     transform_ready_[mask] = 1;
     return t;
@@ -300,60 +265,45 @@ class PrecisePropagator {
     return c;
   }
 
+  // The principal solves of the inline LCP: x = T_A q_ with the kept transform of A.
+  struct InlineLcpPolicy : block_pivoting::MaskedActiveSet {
+    PrecisePropagator& p;
+    block_pivoting::Tolerances tol;
+    Eigen::Matrix<double, kInlineSprings, 1> x;
+
+    InlineLcpPolicy(PrecisePropagator& propagator, const block_pivoting::Tolerances& t)
+        : p(propagator), tol(t) {}
+    int evaluate(long) {
+      x.noalias() = p.lcp_transform(mask).lazyProduct(p.q_);
+      return mark_infeasible(x, kInlineSprings, tol);
+    }
+    LcpError iteration_error(long iteration) const {
+      return LcpError(fmt::format(
+          "block pivoting: no solution after {} iterations (n = {}), the iteration limit "
+          "(M is not a P-matrix?)",
+          iteration, kInlineSprings));
+    }
+  };
+
   // Solves the step's LCP for q_ into next_forces_ (holding the warm start) and slack_; returns
   // the pivots.
   int solve_inline() {
     constexpr int n = kInlineSprings;
-    const double tol_w = kLcpFeasTol * q_.cwiseAbs().maxCoeff();
-    const double tol_z = tol_w / lcp_scale_;
-    if (q_.minCoeff() >= -tol_w) {  // z = 0 solves it
+    const block_pivoting::Tolerances tol =
+        block_pivoting::tolerances(q_.cwiseAbs().maxCoeff(), lcp_scale_);
+    if (block_pivoting::zero_solves(q_.minCoeff(), tol)) {
       next_forces_.setZero();
       slack_ = q_.cwiseMax(0.0);
       return 0;
     }
-    unsigned mask = 0;
+    InlineLcpPolicy policy(*this, tol);
     for (int i = 0; i < n; ++i)
-      if (next_forces_[i] > 0.0) mask |= 1u << i;
-    Eigen::Matrix<double, n, 1> x;
-    int pivots = 0;
-    int best_count = n + 1;
-    int tries = kLcpBlockTries;
-    const long max_iter = 50L * (n + 1) * (n + 1) + (n + 1) * ((1L << n) + kLcpBlockTries + 2);
-    for (long iter = 0;; ++iter) {
-      if (iter >= max_iter) {
-        throw LcpError(fmt::format(
-            "block pivoting: no solution after {} iterations (n = {}), the iteration limit "
-            "(M is not a P-matrix?)",
-            iter, n));
-      }
-      x.noalias() = lcp_transform(mask).lazyProduct(q_);
-      unsigned infeasible = 0;
-      for (int i = 0; i < n; ++i) {
-        const double tol = (mask >> i & 1u) ? tol_z : tol_w;
-        if (x[i] < -tol) infeasible |= 1u << i;
-      }
-      if (infeasible == 0) break;
-      const int count = std::popcount(infeasible);
-      if (count < best_count || tries > 0) {
-        if (count < best_count) {
-          best_count = count;
-          tries = kLcpBlockTries;
-        } else {
-          --tries;
-        }
-        mask ^= infeasible;
-        pivots += count;
-      } else {  // Murty: switch only the largest infeasible index
-        mask ^= 1u << (31 - std::countl_zero(infeasible));
-        pivots += 1;
-      }
-    }
-    for (int i = 0; i < n; ++i) {
-      const double v = std::max(x[i], 0.0);
-      const bool basic_z = mask >> i & 1u;
-      next_forces_[i] = basic_z ? v : 0.0;
-      slack_[i] = basic_z ? 0.0 : v;
-    }
+      if (next_forces_[i] > 0.0) policy.mask |= 1u << i;
+    const long max_iter =
+        50L * (n + 1) * (n + 1) + (n + 1) * ((1L << n) + block_pivoting::kBlockTries + 2);
+    const int pivots = block_pivoting::solve(policy, n, max_iter);
+    block_pivoting::split_basic_vector(
+        policy.x, n, [&](Index i) { return (policy.mask >> i & 1u) != 0; }, next_forces_, slack_);
     return pivots;
   }
 

@@ -1,0 +1,147 @@
+#include "pwl/study/indicators.hpp"
+
+#include <fmt/format.h>
+
+#include <array>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+
+namespace pwl::analysis {
+namespace {
+
+// The accessors of each row. A real or integer field is read and written through its member.
+template <double PointResult::*kField>
+IndicatorValue get_real(const PointResult& r) {
+  return r.*kField;
+}
+template <double PointResult::*kField>
+void set_real(PointResult& r, const IndicatorValue& v) {
+  r.*kField = std::get<double>(v);
+}
+template <int PointResult::*kField>
+IndicatorValue get_integer(const PointResult& r) {
+  return static_cast<long>(r.*kField);
+}
+template <int PointResult::*kField>
+void set_integer(PointResult& r, const IndicatorValue& v) {
+  r.*kField = static_cast<int>(std::get<long>(v));
+}
+IndicatorValue get_regime(const PointResult& r) { return r.regime; }
+void set_regime(PointResult& r, const IndicatorValue& v) { r.regime = std::get<std::string>(v); }
+IndicatorValue get_code(const PointResult& r) {
+  return static_cast<long>(regime_code(r.regime, r.period));
+}
+
+// The table. Append new rows at the end: the result files' existing columns keep their places.
+constexpr std::array<Indicator, 6> kIndicators{{
+    {"regime", "the classified motion: period-k, quasi-periodic, chaotic, unbounded, uncertain",
+     IndicatorType::text, false, "failed", get_regime, set_regime},
+    {"code", "the regime as a small integer for colour maps (regime_code)", IndicatorType::integer,
+     true, "", get_code, nullptr},
+    {"period", "k of a period-k motion, 0 otherwise", IndicatorType::integer, false, "",
+     get_integer<&PointResult::period>, set_integer<&PointResult::period>},
+    {"lambda1", "the largest Lyapunov exponent per forcing period", IndicatorType::real, false, "",
+     get_real<&PointResult::lambda1>, set_real<&PointResult::lambda1>},
+    {"lambda1_error", "the uncertainty of lambda1 (largest of three estimates, lyapunov.hpp)",
+     IndicatorType::real, false, "", get_real<&PointResult::lambda1_error>,
+     set_real<&PointResult::lambda1_error>},
+    {"K", "K of the 0-1 test for chaos on the observable (near 0 regular, near 1 chaotic)",
+     IndicatorType::real, false, "", get_real<&PointResult::K>, set_real<&PointResult::K>},
+}};
+
+std::string cell(const Indicator& indicator, const PointResult& r) {
+  const IndicatorValue v = indicator.get(r);
+  switch (indicator.type) {
+    case IndicatorType::text: {
+      const std::string& text = std::get<std::string>(v);
+      return text.empty() ? std::string(indicator.empty_text) : text;
+    }
+    case IndicatorType::integer:
+      return fmt::format("{}", std::get<long>(v));
+    case IndicatorType::real: {
+      const double x = std::get<double>(v);
+      return std::isnan(x) ? std::string() : fmt::format("{:.17g}", x);
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
+std::span<const Indicator> indicators() { return kIndicators; }
+
+const Indicator* find_indicator(std::string_view name) {
+  for (const Indicator& i : kIndicators) {
+    if (i.name == name) return &i;
+  }
+  return nullptr;
+}
+
+std::string indicator_header() {
+  std::string s;
+  for (const Indicator& i : kIndicators) s += fmt::format("{}{}", s.empty() ? "" : ",", i.name);
+  return s;
+}
+
+std::string indicator_cells(const PointResult& r) {
+  std::string s;
+  bool first = true;
+  for (const Indicator& i : kIndicators) {
+    s += first ? "" : ",";
+    s += cell(i, r);
+    first = false;
+  }
+  return s;
+}
+
+std::string indicator_tokens(const PointResult& r) {
+  std::string s;
+  for (const Indicator& i : kIndicators) {
+    if (i.derived) continue;
+    const IndicatorValue v = i.get(r);
+    switch (i.type) {
+      case IndicatorType::text: {
+        // A token has no blanks; "-" stands for empty text.
+        const std::string& text = std::get<std::string>(v);
+        s += " " + (text.empty() ? std::string("-") : text);
+        break;
+      }
+      case IndicatorType::integer:
+        s += fmt::format(" {}", std::get<long>(v));
+        break;
+      case IndicatorType::real:
+        s += fmt::format(" {:.17g}", std::get<double>(v));
+        break;
+    }
+  }
+  return s;
+}
+
+bool read_indicator_token(const Indicator& indicator, std::string_view token, PointResult& r) {
+  if (indicator.derived || indicator.set == nullptr || token.empty()) return false;
+  const std::string s(token);
+  switch (indicator.type) {
+    case IndicatorType::text:
+      indicator.set(r, s == "-" ? std::string() : s);
+      return true;
+    case IndicatorType::integer: {
+      char* end = nullptr;
+      errno = 0;
+      const long v = std::strtol(s.c_str(), &end, 10);
+      if (errno != 0 || end != s.c_str() + s.size()) return false;
+      indicator.set(r, v);
+      return true;
+    }
+    case IndicatorType::real: {
+      char* end = nullptr;
+      const double v = std::strtod(s.c_str(), &end);
+      if (end != s.c_str() + s.size()) return false;
+      indicator.set(r, v);
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace pwl::analysis
