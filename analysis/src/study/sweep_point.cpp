@@ -10,6 +10,7 @@
 #include "pwl/analysis/lyapunov.hpp"
 #include "pwl/analysis/zero_one_test.hpp"
 #include "pwl/errors.hpp"
+#include "pwl/integrators/method_table.hpp"
 
 namespace pwl::analysis {
 
@@ -20,6 +21,11 @@ std::string lyapunov_estimate_name(LyapunovEstimate estimate) {
     case LyapunovEstimate::two_trajectories: return "two-trajectories";
   }
   return "tangent-vector";
+}
+
+LyapunovEstimate default_lyapunov_estimate(Method method) {
+  return method_traits(method).tangent_map ? LyapunovEstimate::tangent_vector
+                                           : LyapunovEstimate::two_trajectories;
 }
 
 LyapunovEstimate parse_lyapunov_estimate(const std::string& name) {

@@ -114,8 +114,7 @@ void analyze(const AnalyzeOptions& o) {
   if (method.fixed_grid) s.steps_per_period = static_cast<int>(std::lround(period / s.method.step));
   s.observable = mass - 1;  // the 0-1 test reads x of the drawn mass
   if (o.lyapunov.empty()) {
-    s.lyapunov_estimate = method.tangent_map ? analysis::LyapunovEstimate::tangent_frame
-                                             : analysis::LyapunovEstimate::two_trajectories;
+    s.lyapunov_estimate = analysis::default_lyapunov_estimate(s.method.method);
   } else {
     s.lyapunov_estimate = analysis::parse_lyapunov_estimate(o.lyapunov);
     if (s.lyapunov_estimate != analysis::LyapunovEstimate::two_trajectories &&
@@ -191,9 +190,9 @@ void add_analyze_command(CLI::App& app) {
   c->add_option("--mass", options->mass,
                 "Mass (1-based) drawn in the figure and read by the 0-1 test (default: last)");
   c->add_option("--lyapunov", options->lyapunov,
-                "How λ1 is estimated: tangent-vector (as pwl sweep and map do by default), "
-                "tangent-frame or two-trajectories (default: tangent-frame when the method has "
-                "an exact tangent map, else two-trajectories)")
+                "How λ1 is estimated: tangent-vector, tangent-frame or two-trajectories\n"
+                "(default, as pwl sweep and map: tangent-vector when the method has an exact\n"
+                "tangent map, else two-trajectories)")
       ->check(CLI::IsMember({"tangent-vector", "tangent-frame", "two-trajectories"}));
   c->add_option("--out", options->out, "Output folder");
   c->callback([options] { analyze(*options); });

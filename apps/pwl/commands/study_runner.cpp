@@ -64,8 +64,9 @@ analysis::PointSettings PointFlags::settings(int masses) const {
   s.recorded_periods = periods;
   s.steps_per_period = steps_per_period;
   s.lyapunov = !no_lyapunov;
-  s.lyapunov_estimate = analysis::parse_lyapunov_estimate(lyapunov);
   s.method.method = parse_method(method);
+  s.lyapunov_estimate = lyapunov.empty() ? analysis::default_lyapunov_estimate(s.method.method)
+                                         : analysis::parse_lyapunov_estimate(lyapunov);
   s.method.tolerance = tolerance;
   s.method.locate_kinks = locate_kinks;
   s.method.lcp = parse_lcp_algorithm(lcp_solver);
@@ -103,7 +104,8 @@ void add_point_flags(CLI::App& c, PointFlags& f, bool with_record) {
   c.add_flag("--no-lyapunov", f.no_lyapunov, "Skip λ1 (then only the period search and K decide)");
   c.add_option("--lyapunov", f.lyapunov,
                "How λ1 is estimated: tangent-vector, tangent-frame (both need a method with an\n"
-               "exact tangent map; without one λ1 is left out) or two-trajectories (any method)")
+               "exact tangent map; without one λ1 is left out) or two-trajectories (any method).\n"
+               "Default: tangent-vector with a tangent map, else two-trajectories (as analyze)")
       ->check(CLI::IsMember({"tangent-vector", "tangent-frame", "two-trajectories"}));
   c.add_option("--method", f.method, method_help())->check(CLI::IsMember(method_names()));
   c.add_option("--tol", f.tolerance, "Relative and absolute tolerance of dopri5/rkf78")

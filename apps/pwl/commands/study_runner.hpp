@@ -51,7 +51,7 @@ struct PointFlags {
   int steps_per_period = 200;
   std::vector<std::string> record;  // component names: x1..xn, v1..vn
   bool no_lyapunov = false;
-  std::string lyapunov = "tangent-vector";
+  std::string lyapunov;  // empty: default_lyapunov_estimate of the method
   std::string method = "pim";
   double tolerance = 1e-10;
   bool locate_kinks = false;

@@ -8,6 +8,7 @@
 
 #include "pwl/integrators/banded_propagator.hpp"
 #include "pwl/errors.hpp"
+#include "pwl/numerics/state_checks.hpp"
 #include "integrators/fixed_step_count.hpp"
 #include "pwl/numerics/substructure_exponential.hpp"
 
@@ -16,23 +17,9 @@ namespace pwl {
 bool BandedPimOptions::is_valid(std::string* why) const {
   std::string scratch;
   if (why == nullptr) why = &scratch;
-  if (!std::isfinite(step) || step <= 0.0) {
-    *why = fmt::format("step = {} must be positive and finite", step);
-    return false;
-  }
-  if (!(divergence_bound > 0.0)) {
-    *why = fmt::format("divergence_bound = {} must be positive", divergence_bound);
-    return false;
-  }
-  if (!band.is_valid(why)) {
-    *why = "band." + *why;
-    return false;
-  }
-  if (!lcp.is_valid(why)) {
-    *why = "lcp." + *why;
-    return false;
-  }
-  return true;
+  return check_step_settings(step, divergence_bound, why) &&
+         check_nested(band.is_valid(why), "band", why) &&
+         check_nested(lcp.is_valid(why), "lcp", why);
 }
 
 BandedLayout banded_layout(const GapStructure& structure) {

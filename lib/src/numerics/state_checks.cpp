@@ -36,4 +36,21 @@ void throw_divergence(double t, double largest, double bound) {
       bound));
 }
 
+bool check_step_settings(double step, double divergence_bound, std::string* why) {
+  if (!std::isfinite(step) || step <= 0.0) {
+    *why = fmt::format("step = {} must be positive and finite", step);
+    return false;
+  }
+  if (!(divergence_bound > 0.0)) {
+    *why = fmt::format("divergence_bound = {} must be positive", divergence_bound);
+    return false;
+  }
+  return true;
+}
+
+bool check_nested(bool valid, std::string_view field, std::string* why) {
+  if (!valid) *why = std::string(field) + "." + *why;
+  return valid;
+}
+
 }  // namespace pwl

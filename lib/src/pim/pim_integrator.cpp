@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "pwl/errors.hpp"
+#include "pwl/numerics/state_checks.hpp"
 #include "integrators/fixed_step_count.hpp"
 #include "pwl/integrators/precise_propagator.hpp"
 
@@ -13,15 +14,7 @@ namespace pwl {
 bool PimOptions::is_valid(std::string* why) const {
   std::string scratch;
   if (why == nullptr) why = &scratch;
-  if (!std::isfinite(step) || step <= 0.0) {
-    *why = fmt::format("step = {} must be positive and finite", step);
-    return false;
-  }
-  if (!(divergence_bound > 0.0)) {
-    *why = fmt::format("divergence_bound = {} must be positive", divergence_bound);
-    return false;
-  }
-  return exponential.is_valid(why);
+  return check_step_settings(step, divergence_bound, why) && exponential.is_valid(why);
 }
 
 namespace {

@@ -28,19 +28,9 @@ namespace pwl {
 bool BandedSwitchingPimOptions::is_valid(std::string* why) const {
   std::string scratch;
   if (why == nullptr) why = &scratch;
-  if (!pim.is_valid(why)) {
-    *why = "pim." + *why;
-    return false;
-  }
-  if (!band.is_valid(why)) {
-    *why = "band." + *why;
-    return false;
-  }
-  if (!lcp.is_valid(why)) {
-    *why = "lcp." + *why;
-    return false;
-  }
-  return true;
+  return check_nested(pim.is_valid(why), "pim", why) &&
+         check_nested(band.is_valid(why), "band", why) &&
+         check_nested(lcp.is_valid(why), "lcp", why);
 }
 
 namespace {

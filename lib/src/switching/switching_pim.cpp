@@ -25,16 +25,9 @@ namespace pwl {
 bool SwitchingPimOptions::is_valid(std::string* why) const {
   std::string scratch;
   if (why == nullptr) why = &scratch;
-  if (!std::isfinite(step) || step <= 0.0) {
-    *why = fmt::format("step = {} must be positive and finite", step);
-    return false;
-  }
+  if (!check_step_settings(step, divergence_bound, why)) return false;
   if (force_degree < 0 || force_degree > 8) {
     *why = fmt::format("force_degree = {} must be in 0..8", force_degree);
-    return false;
-  }
-  if (!(divergence_bound > 0.0)) {
-    *why = fmt::format("divergence_bound = {} must be positive", divergence_bound);
     return false;
   }
   if (!(max_step_argument > 0.0)) {

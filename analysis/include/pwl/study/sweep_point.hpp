@@ -44,6 +44,10 @@ enum class LyapunovEstimate {
 std::string lyapunov_estimate_name(LyapunovEstimate estimate);
 // The inverse. Throws InputError naming the value and the accepted names.
 LyapunovEstimate parse_lyapunov_estimate(const std::string& name);
+// The estimate every job uses unless told otherwise, so that `pwl analyze` and a one-point sweep
+// of the same case answer alike: one tangent vector for a method with an exact tangent map, two
+// nearby trajectories for one without.
+LyapunovEstimate default_lyapunov_estimate(Method method);
 
 struct PointSettings {
   int transient_periods = 500;  // forcing periods integrated and discarded (>= 0)
