@@ -1,7 +1,7 @@
 #pragma once
 // Runs the shipped gnuplot scripts. Figures are a by-product: a machine without gnuplot still gets
 // its CSV files, and a warning instead of a failure. Every figure is drawn twice, as PNG and SVG,
-// through plots/terminal.gp, so that both look alike.
+// through plots/scripts/terminal.gp, so that both look alike.
 #include <functional>
 #include <string>
 
