@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "analysis/point_checks.hpp"
 #include "pwl/errors.hpp"
 
 namespace pwl::analysis {
@@ -134,15 +135,8 @@ Classification classify_motion(const std::vector<Vector>& points, const MotionEv
                                const ClassifierOptions& options) {
   std::string why;
   if (!options.is_valid(&why)) throw InputError(why);
-  if (points.empty()) throw InputError("points: the sequence is empty (size 0)");
+  detail::check_points(points, false);  // non-finite points are evidence: unbounded motion
   const Index dim = points.front().size();
-  if (dim == 0) throw InputError("points[0]: a point has dimension 0");
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    if (points[i].size() != dim) {
-      throw InputError(fmt::format("points[{}]: dimension {} differs from points[0]'s {}", i,
-                                   points[i].size(), dim));
-    }
-  }
   check_evidence(evidence);
 
   Classification c;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "analysis/point_checks.hpp"
 #include "pwl/errors.hpp"
 
 namespace pwl::analysis {
@@ -17,7 +18,11 @@ bool fail(std::string* why, std::string message) {
   return false;
 }
 
-void check_points(const std::vector<Vector>& points) {
+}  // namespace
+
+namespace detail {
+
+void check_points(const std::vector<Vector>& points, bool finite) {
   if (points.empty()) throw InputError("points: the sequence is empty (size 0)");
   const Index dim = points.front().size();
   if (dim == 0) throw InputError("points[0]: a point has dimension 0");
@@ -26,13 +31,17 @@ void check_points(const std::vector<Vector>& points) {
       throw InputError(fmt::format("points[{}]: dimension {} differs from points[0]'s {}", i,
                                    points[i].size(), dim));
     }
-    for (Index j = 0; j < dim; ++j) {
+    for (Index j = 0; finite && j < dim; ++j) {
       if (!std::isfinite(points[i][j])) {
         throw InputError(fmt::format("points[{}][{}] = {} is not finite", i, j, points[i][j]));
       }
     }
   }
 }
+
+}  // namespace detail
+
+namespace {
 
 // Greedy clustering: a point joins the first representative within `radius`.
 int count_distinct(const std::vector<Vector>& points, std::size_t first, double radius) {
@@ -75,7 +84,7 @@ bool PeriodOptions::is_valid(std::string* why) const {
 PeriodResult detect_period(const std::vector<Vector>& points, const PeriodOptions& options) {
   std::string why;
   if (!options.is_valid(&why)) throw InputError(why);
-  check_points(points);
+  detail::check_points(points, true);
 
   const std::size_t n = points.size();
   PeriodResult result;

@@ -94,7 +94,6 @@ void sweep(const SweepFlags& f) {
                records.size());
     if (f.run.no_plot) return;
     write_plotted_points(o, records, f.run.out + "/bifurcation_points.csv");
-    std::string why;
     const auto definitions = [&](const std::string& format) {
       return fmt::format(
           "poincare='{0}/bifurcation_points.csv'; classes='{0}/classification.csv'; "
@@ -110,11 +109,8 @@ void sweep(const SweepFlags& f) {
               study_title(o.model(), o.point))),
           format);
     };
-    if (draw_figure(scripts_directory() + "/bifurcation.gp", definitions, &why)) {
-      fmt::print("wrote {}/bifurcation.png and .svg\n", f.run.out);
-    } else {
-      fmt::print(stderr, "pwl sweep: no figure: {}\n", why);
-    }
+    draw_figure_and_report(scripts_directory() + "/bifurcation.gp", definitions,
+                           f.run.out + "/bifurcation", "pwl sweep", false);
   };
   run_study(study, f.run);
 }
