@@ -240,3 +240,133 @@ TEST_CASE("switching PIM: bad input names the field", "[switching]") {
     CHECK_NOTHROW(make_switching_pim(hard, so));
   }
 }
+
+namespace {
+
+// The state [x; x'] of an integrator.
+Vector state_of(const Integrator& integrator) {
+  Vector y(2 * integrator.dofs());
+  y << integrator.position(), integrator.velocity();
+  return y;
+}
+
+// Central differences (step h) of the flow y(t0) -> y(t1) of the integrators `make` builds, in
+// every state direction: an approximation of the flow's Jacobian.
+template <class Make>
+Matrix flow_differences(const Make& make, double t0, double t1, const Vector& y0, double h) {
+  const Index n = y0.size() / 2;
+  const auto flow = [&](const Vector& y) {
+    const auto integrator = make();
+    integrator->set_state(t0, y.head(n), y.tail(n));
+    integrator->advance_to(t1);
+    return state_of(*integrator);
+  };
+  Matrix d(2 * n, 2 * n);
+  for (Index j = 0; j < 2 * n; ++j) {
+    Vector plus = y0, minus = y0;
+    plus[j] += h;
+    minus[j] -= h;
+    d.col(j) = (flow(plus) - flow(minus)) / (2 * h);
+  }
+  return d;
+}
+
+}  // namespace
+
+TEST_CASE("switching PIM: the tangent map is the derivative of its own one-period map",
+          "[switching][tangent]") {
+  // Figure 4a from the state reached after 100 periods (on the period-2 orbit), one period on: the
+  // springs open and close five times in it, so the period has smooth steps and switching
+  // steps. The tangent of
+  // the identity is the Jacobian of the switching PIM's map; central differences of that map
+  // (h = 1e-6) agree with it up to their own error (the map is smooth between switches, and the
+  // located switches' timing enters only through the spring force at the switch, which is zero).
+  const NondimensionalChain chain = paper_five_dof_case("4a");
+  const GapStructure s = make_chain(chain);
+  const double T = chain.period();
+  struct Variant {
+    int degree;
+    bool end_slope;
+    bool locate;
+  };
+  // Without located switches the smooth step's LCP alone changes the modes (and the tangent
+  // takes the general path rather than the mode's operators).
+  for (const Variant variant : {Variant{2, true, true}, Variant{0, false, true},
+                                Variant{3, false, true}, Variant{2, true, false}}) {
+    CAPTURE(variant.degree, variant.end_slope, variant.locate);
+    SwitchingPimOptions so;
+    so.step = T / 200;
+    so.force_degree = variant.degree;
+    so.end_derivative = variant.end_slope;
+    so.locate_switches = variant.locate;
+    const auto make = [&] { return make_switching_pim(s, so); };
+    auto start = make();
+    start->advance_to(100 * T);
+    const Vector y0 = state_of(*start);
+
+    auto tangent_run = make();
+    tangent_run->set_state(100 * T, start->position(), start->velocity());
+    Matrix J = Matrix::Identity(10, 10);
+    tangent_run->advance_with_tangent(101 * T, J);
+    // The motion is that of advance_to from the same start, to the last bit.
+    auto plain_run = make();
+    plain_run->set_state(100 * T, start->position(), start->velocity());
+    plain_run->advance_to(101 * T);
+    CHECK((state_of(*tangent_run) - state_of(*plain_run)).cwiseAbs().maxCoeff() == 0.0);
+    if (variant.locate) {
+      CHECK(tangent_run->diagnostics().switches >= 4);
+      CHECK(tangent_run->diagnostics().switching_steps >= 4);
+    }
+
+    const Matrix D = flow_differences(make, 100 * T, 101 * T, y0, 1e-6);
+    const double scale = J.cwiseAbs().maxCoeff();
+    const double relative = (J - D).cwiseAbs().maxCoeff() / scale;
+    INFO("|J| " << scale << ", |J - differences| / |J| = " << relative);
+    CHECK(scale > 1e-2);
+    CHECK(relative < 1e-6);
+  }
+  SECTION("a tangent with the wrong number of rows is refused") {
+    SwitchingPimOptions so;
+    so.step = T / 200;
+    auto pim = make_switching_pim(s, so);
+    Matrix wrong = Matrix::Identity(5, 5);
+    CHECK_THROWS_AS(pim->advance_with_tangent(T, wrong), InputError);
+    // Nothing moved, and the integrator still works.
+    CHECK(pim->time() == 0.0);
+    CHECK_NOTHROW(pim->advance_to(T));
+  }
+}
+
+TEST_CASE("switching PIM: the tangent map converges to the exact flow's Jacobian at order 5",
+          "[switching][tangent]") {
+  // Figure 4a, one period from the exact solver's state after 100 periods (five switches in
+  // it). The exact flow's Jacobian from central differences of the event-driven solver (exact up
+  // to rounding, so the differences are good to about 1e-9); the switching PIM's tangent at
+  // η = T/10 ... T/40 approaches it at the order of the method (d = 2 with the end slope: 5).
+  const NondimensionalChain chain = paper_five_dof_case("4a");
+  const GapStructure s = make_chain(chain);
+  const double T = chain.period();
+  EventDrivenSolver exact(s);
+  exact.advance_to(100 * T);
+  const Vector y0 = state_of(exact);
+  const Matrix J_exact = flow_differences(
+      [&] { return make_event_driven_solver(s); }, 100 * T, 101 * T, y0, 1e-6);
+  std::vector<double> steps, errors;
+  for (int n : {10, 20, 40}) {
+    SwitchingPimOptions so;
+    so.step = T / n;
+    auto pim = make_switching_pim(s, so);
+    pim->set_state(100 * T, y0.head(5), y0.tail(5));
+    Matrix J = Matrix::Identity(10, 10);
+    pim->advance_with_tangent(101 * T, J);
+    steps.push_back(so.step);
+    errors.push_back((J - J_exact).cwiseAbs().maxCoeff() / J_exact.cwiseAbs().maxCoeff());
+  }
+  const double order = fitted_order(steps, errors);
+  INFO("relative errors " << errors[0] << ", " << errors[1] << ", " << errors[2] << "; order "
+                          << order);
+  CHECK(errors[2] < errors[1]);
+  CHECK(errors[1] < errors[0]);
+  CHECK(errors[2] > 3e-8);  // well above the differences' own error
+  CHECK(order > 4.0);
+}

@@ -304,10 +304,15 @@ TEST_CASE("the method's capabilities decide how λ1 is estimated", "[sweep_point
   CHECK(std::abs(frame.lambda1 - decay) <= frame.lambda1_error + 1e-3);
   CHECK(vector.final_state == frame.final_state);  // the same motion, another estimate
 
-  // The exact solver has no tangent map: no λ1 with a tangent estimate, two nearby trajectories
-  // on request.
+  // The exact solver has an exact tangent map too: the same decay from its tangent vector.
   s.method.method = Method::exact;
   s.lyapunov_estimate = LyapunovEstimate::tangent_vector;
+  const PointResult exact = evaluate_point(point, Vector::Zero(4), s);
+  CHECK(std::abs(exact.lambda1 - decay) <= exact.lambda1_error + 1e-3);
+
+  // dopri5 has no tangent map: no λ1 with a tangent estimate, two nearby trajectories on request.
+  s.method.method = Method::dopri5;
+  s.method.tolerance = 1e-12;
   const PointResult none = evaluate_point(point, Vector::Zero(4), s);
   CHECK(std::isnan(none.lambda1));
   CHECK(none.regime == "period-1");

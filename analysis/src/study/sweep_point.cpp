@@ -39,11 +39,7 @@ LyapunovEstimate parse_lyapunov_estimate(const std::string& name) {
 }
 
 MethodSettings PointSettings::method_for(double period) const {
-  MethodSettings m = method;
-  const MethodTraits& row = method_traits(m.method);
-  if (row.fixed_grid) m.step = period / steps_per_period;
-  if (row.adaptive) m.max_step = period / 8;
-  return m;
+  return method.for_period(period, steps_per_period);
 }
 
 bool PointSettings::is_valid(int dofs, std::string* why) const {

@@ -99,6 +99,8 @@ class Mode {
   virtual double nominal_spacing() const = 0;
   virtual double response_scale() const = 0;  // size of the particular response's x
   virtual bool modal() const = 0;
+  // tangent (2n x p) <- exp(H_A delta) tangent: the Jacobian of this mode's flow over delta >= 0.
+  virtual void apply_flow_jacobian(double delta, Matrix& tangent) = 0;
 };
 
 Matrix mode_state_matrix(const Structure& s, const Vector& kmask) {
@@ -273,6 +275,28 @@ class ModalMode final : public Mode {
   double response_scale() const override { return response_scale_; }
   bool modal() const override { return true; }
 
+  // exp(H_A δ) Y = Re(V e^{Λδ} V⁻¹ Y), in real arithmetic on the real and imaginary parts of V
+  // and V⁻¹ (split on first use): four 2n x 2n by 2n x p products.
+  void apply_flow_jacobian(double delta, Matrix& tangent) override {
+    if (!(delta > 0.0) || tangent.cols() == 0) return;
+    if (v_re_.size() == 0) {
+      v_re_ = v_.real();
+      v_im_ = v_.imag();
+      vinv_re_ = vinv_.real();
+      vinv_im_ = vinv_.imag();
+    }
+    const ComplexVector e = (lambda_ * delta).array().exp().matrix();
+    const Vector e_re = e.real(), e_im = e.imag();
+    modal_re_.noalias() = vinv_re_ * tangent;  // V⁻¹ Y
+    modal_im_.noalias() = vinv_im_ * tangent;
+    scaled_re_ = (modal_re_.array().colwise() * e_re.array() -
+                  modal_im_.array().colwise() * e_im.array()).matrix();  // e^{Λδ} V⁻¹ Y
+    modal_im_ = (modal_re_.array().colwise() * e_im.array() +
+                 modal_im_.array().colwise() * e_re.array()).matrix();
+    tangent.noalias() = v_re_ * scaled_re_;  // Re(V ·)
+    tangent.noalias() -= v_im_ * modal_im_;
+  }
+
  private:
   struct ModalTerm {
     double omega;
@@ -308,6 +332,9 @@ class ModalMode final : public Mode {
   double t0_ = 0.0;
   ComplexVector c_, z_, lz_, llz_;
   Vector g_, r_, a_, weights_;
+  // The tangent map: the parts of V and V⁻¹ (set on first use) and 2n x p work space.
+  Matrix v_re_, v_im_, vinv_re_, vinv_im_;
+  Matrix modal_re_, modal_im_, scaled_re_;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -410,6 +437,17 @@ class ExponentialMode final : public Mode {
   double nominal_spacing() const override { return spacing_; }
   double response_scale() const override { return 0.0; }
   bool modal() const override { return false; }
+
+  // exp(H_A δ), the top-left 2n x 2n block of exp(Ĥ_A δ) (Ĥ_A is block upper triangular), by the
+  // 2^N algorithm on H_A alone; not cached (segment lengths do not repeat).
+  void apply_flow_jacobian(double delta, Matrix& tangent) override {
+    if (!(delta > 0.0) || tangent.cols() == 0) return;
+    const Index n2 = 2 * s_.n;
+    if (state_matrix_.size() == 0) state_matrix_ = h_.topLeftCorner(n2, n2);
+    const Matrix E = precise_exponential(state_matrix_, delta, exponential_);
+    product_.noalias() = E * tangent;
+    tangent = product_;
+  }
   const Vector& start_state() const { return w0_; }
   double start_time() const { return t0_; }
 
@@ -440,6 +478,7 @@ class ExponentialMode final : public Mode {
   Vector w0_;
   double t0_ = 0.0;
   std::map<double, Matrix> cache_;
+  Matrix state_matrix_, product_;  // the tangent map: H_A (set on first use), work space
 };
 
 // The current mode's gap functions for the event search.
@@ -581,6 +620,9 @@ struct EventDrivenSolver::Impl {
     v = state.tail(s.n);
   }
 
+  // advance_to, with the tangent map applied to *tangent when it is not null.
+  void advance(double t_end, Matrix* tangent, const StepObserver& observer);
+
   void check(double time) const {
     const double largest = state.cwiseAbs().maxCoeff();
     if (!(largest <= options.divergence_bound)) {
@@ -668,8 +710,9 @@ double EventDrivenSolver::time() const { return impl_->t; }
 const Vector& EventDrivenSolver::position() const { return impl_->x; }
 const Vector& EventDrivenSolver::velocity() const { return impl_->v; }
 
-void EventDrivenSolver::advance_to(double t_end, const StepObserver& observer) {
-  Impl& p = *impl_;
+void EventDrivenSolver::Impl::advance(double t_end, Matrix* tangent,
+                                     const StepObserver& observer) {
+  Impl& p = *this;
   if (!std::isfinite(t_end) || t_end < p.t) {
     throw InputError(fmt::format("event-driven solver: advance_to(t_end = {}) must be finite and "
                                  "not before the current time {}",
@@ -677,6 +720,7 @@ void EventDrivenSolver::advance_to(double t_end, const StepObserver& observer) {
   }
   long events = 0;
   event_detail::SearchSettings settings;
+  double segment_start = p.t;  // the tangent map: where the current mode's segment began
   while (true) {
     settings.nominal_spacing = p.mode->nominal_spacing();
     settings.min_width = p.min_width(t_end);
@@ -689,6 +733,10 @@ void EventDrivenSolver::advance_to(double t_end, const StepObserver& observer) {
     p.t = r.at.t;
     p.sync_state();
     p.check(p.t);
+    if (tangent != nullptr) {
+      p.mode->apply_flow_jacobian(p.t - segment_start, *tangent);
+      segment_start = p.t;
+    }
     if (!r.found) {
       p.now = r.at;
       p.t = t_end;
@@ -726,6 +774,20 @@ void EventDrivenSolver::advance_to(double t_end, const StepObserver& observer) {
     ++p.stats.steps;
     if (observer) observer(p.t, p.x, p.v);
   }
+}
+
+void EventDrivenSolver::advance_to(double t_end, const StepObserver& observer) {
+  impl_->advance(t_end, nullptr, observer);
+}
+
+void EventDrivenSolver::advance_with_tangent(double t_end, Matrix& tangent,
+                                             const StepObserver& observer) {
+  const Index rows = 2 * impl_->s.n;
+  if (tangent.rows() != rows) {
+    throw InputError(fmt::format("event-driven solver: the tangent has {} rows, the state {}",
+                                 tangent.rows(), rows));
+  }
+  impl_->advance(t_end, &tangent, observer);
 }
 
 IntegratorStats EventDrivenSolver::stats() const { return impl_->stats; }

@@ -92,15 +92,15 @@ constexpr std::array<MethodTraits, 9> kTable{{
      true, false, false, false, false, false, false, true, false, 2, 0, 0, make_pim_banded},
     {Method::pim_switching, "pim-switching", "switching PIM",
      "higher order, located switches (dense or banded by size)",
-     true, false, false, false, true, true, true, false, false, 5, 0, 0, make_switching},
+     true, true, false, false, true, true, true, false, false, 5, 0, 0, make_switching},
     {Method::pim_switching_dense, "pim-switching-dense", "switching PIM",
      "the switching PIM with dense operators",
-     true, false, false, false, true, true, false, false, false, 5, 0, 0, make_switching_dense},
+     true, true, false, false, true, true, false, false, false, 5, 0, 0, make_switching_dense},
     {Method::pim_switching_banded, "pim-switching-banded", "banded switching PIM",
      "the switching PIM with banded operators",
-     true, false, false, false, true, false, false, true, false, 5, 0, 0, make_switching_banded},
+     true, true, false, false, true, false, false, true, false, 5, 0, 0, make_switching_banded},
     {Method::exact, "exact", "exact event-driven", "event-driven, closed form per contact state",
-     false, false, false, false, true, false, false, false, true, 0, 0, 62, make_exact},
+     false, true, false, false, true, false, false, false, true, 0, 0, 62, make_exact},
     {Method::dopri5, "dopri5", "dopri5", "Dormand-Prince 5(4), with --tol and --locate-kinks",
      false, false, true, true, false, false, false, false, false, 5, 0, 0,
      make_runge_kutta<RungeKuttaMethod::dopri5>},
@@ -194,6 +194,14 @@ std::unique_ptr<Integrator> make_integrator(const GapStructure& structure,
   std::unique_ptr<Integrator> result = method_traits(s.method).make(structure, s);
   result->set_state(0.0, Vector::Zero(structure.dofs()), Vector::Zero(structure.dofs()));
   return result;
+}
+
+MethodSettings MethodSettings::for_period(double period, int steps_per_period) const {
+  MethodSettings m = *this;
+  const MethodTraits& row = method_traits(m.method);
+  if (row.fixed_grid) m.step = period / steps_per_period;
+  if (row.adaptive) m.max_step = period / 8;
+  return m;
 }
 
 }  // namespace pwl

@@ -215,6 +215,9 @@ class BandedStepper final : public SwitchingPim,
                                      eta_, why));
       }
       solver_.set_matrix(lcp);
+      lcp_ = lcp;
+      lcp_lower_ = lcp_.lower_bandwidth();
+      lcp_upper_ = lcp_.upper_bandwidth();
     }
 
     const int terms = std::max(o_.max_series_terms, d_ + 2) + 1;
@@ -268,6 +271,27 @@ class BandedStepper final : public SwitchingPim,
         [this] { sync(); });
   }
 
+  // advance_to, and the tangent map of every step applied to `tangent` (see
+  // banded_switching_pim.hpp): column by column, O(n q) per column and step.
+  void advance_with_tangent(double t_end, Matrix& tangent, const StepObserver& observer) override {
+    if (tangent.rows() != 2 * n_) {
+      throw InputError(fmt::format("tangent has {} rows; the state [x; x'] has {}", tangent.rows(),
+                                   2 * n_));
+    }
+    tangent_ = &tangent;
+    struct Release {
+      BandedStepper* s;
+      ~Release() { s->tangent_ = nullptr; }
+    } release{this};
+    detail::advance_on_grid(
+        t_end, time(), eta_, observer, position_, velocity_,
+        [this] {
+          step_with_tangent();
+          return time();
+        },
+        [this] { sync(); });
+  }
+
  private:
   void set_mode(Index j, bool on) {
     mode_[j] = on ? 1.0 : 0.0;
@@ -288,13 +312,151 @@ class BandedStepper final : public SwitchingPim,
   // of the acting ones otherwise (O(contacts · q)).
   void add_forces(const BandedMatrix& A, const BandedMatrix& columns, const Vector& p,
                   Vector& y) const {
-    if (acting_.empty()) return;
-    if (4 * static_cast<Index>(acting_.size()) > m_) {
+    add_forces(A, columns, p, y, acting_);
+  }
+  // The same for p zero outside `acting`.
+  void add_forces(const BandedMatrix& A, const BandedMatrix& columns, const Vector& p, Vector& y,
+                  const std::vector<int>& acting) const {
+    if (acting.empty()) return;
+    if (4 * static_cast<Index>(acting.size()) > m_) {
       A.multiply_add(p.data(), y.data());
     } else {
-      columns.transpose_multiply_add(p.data(), acting_.data(), static_cast<Index>(acting_.size()),
+      columns.transpose_multiply_add(p.data(), acting.data(), static_cast<Index>(acting.size()),
                                      y.data());
     }
+  }
+
+  // One step and its tangent map. A switching step maps the tangent piece by piece as it goes
+  // (ModeSeries::tangent_piece); a smooth step is affine in the start state for the mode it
+  // starts in and the LCP's active set, and tangent_smooth_step() applies its linear part after it.
+  void step_with_tangent() {
+    start_mode_ = mode_;
+    start_acting_.clear();
+    for (Index j = 0; j < m_; ++j) {
+      if (mode_[j] > 0.0) start_acting_.push_back(static_cast<int>(j));
+    }
+    const long before = diagnostics_.switching_steps;
+    step();
+    if (diagnostics_.switching_steps == before) tangent_smooth_step();
+  }
+
+  // The linear part of a smooth step applied to each tangent column: the step's formula with the
+  // loads and the spring offsets left out, the force derivatives p_r of the start mode, and the
+  // LCP replaced by the linear solve on its active set A (the derivative of the LCP's solution
+  // where A is locally constant: dz_A = -M_AA⁻¹ dq_A, dz = 0 elsewhere): one banded product
+  // with T, d + 1 sparse recursion terms and the forces of the touching springs, as the step.
+  void tangent_smooth_step() {
+    Matrix& Y = *tangent_;
+    const int last = d_ + (end_derivative_ ? 1 : 0);  // the last p_r the step uses
+    if (m_ > 0 && !acting_.empty()) factor_active_set(acting_);
+    for (Index c = 0; c < Y.cols(); ++c) {
+      t_x_ = Y.col(c).head(n_);
+      t_u_ = Y.col(c).tail(n_);
+      t_y_.resize(2 * n_);
+      t_bar_.resize(2 * n_);
+      for (Index i = 0; i < n_; ++i) {
+        t_y_[2 * i] = t_x_[i];
+        t_y_[2 * i + 1] = t_u_[i];
+      }
+      transition_.multiply(t_y_.data(), t_bar_.data());
+      if (end_derivative_) t_slope_.setZero(m_);
+      for (int r = 0; r <= last && m_ > 0; ++r) {
+        t_g_.noalias() = gap_rows_ * t_x_;
+        t_p_ = start_mode_.cwiseProduct(stiffnesses_.cwiseProduct(t_g_));
+        const auto ru = static_cast<std::size_t>(r);
+        add_forces(correction_[ru], correction_columns_[ru], t_p_, t_bar_, start_acting_);
+        if (end_derivative_ && r >= 1) t_slope_ += static_cast<double>(r) * t_p_;
+        if (r == last) break;
+        const double f = eta_ / (r + 1);
+        if (r < d_) {
+          t_acc_.noalias() = stiffness_part_ * t_x_;
+          t_acc_.noalias() += damping_part_ * t_u_;
+          if (!start_acting_.empty()) t_acc_.noalias() += force_part_ * t_p_;
+        }
+        t_x_ = f * t_u_;
+        if (r < d_) t_u_ = f * t_acc_;
+      }
+      if (m_ > 0 && !acting_.empty()) {
+        // -dq = K2 W^T dbar_x; dz on the active set.
+        for (Index i = 0; i < n_; ++i) t_half_[i] = t_bar_[2 * i];
+        t_g_.noalias() = spring_rows_ * t_half_;
+        solve_active_set(acting_, t_g_, t_z_);
+        add_forces(phi_, phi_columns_, t_z_, t_bar_);
+        if (end_derivative_ && o_.locate_switches) {
+          // The end-slope correction, with the slope of the new state (same mode at both ends).
+          for (Index i = 0; i < n_; ++i) t_half_[i] = t_bar_[2 * i + 1];
+          t_g_.noalias() = gap_rows_ * t_half_;
+          t_slope_ = eta_ * mode_.cwiseProduct(stiffnesses_.cwiseProduct(t_g_)) - t_slope_;
+          add_forces(slope_, slope_columns_, t_slope_, t_bar_);
+        }
+      }
+      for (Index i = 0; i < n_; ++i) {
+        Y(i, c) = t_bar_[2 * i];
+        Y(n_ + i, c) = t_bar_[2 * i + 1];
+      }
+    }
+  }
+
+  // The band LU (no pivoting: M is a P-matrix, so every leading principal minor of M_AA is
+  // positive) of M_AA for the ascending index set A, kept in lu_ with lower + upper + 1 entries
+  // per row (row k holds columns k - lower .. k + upper of M_AA, L below the diagonal with a unit
+  // diagonal, U from it). M_AA is banded with M's bandwidths. The factors of the previous set are
+  // kept: row k depends on the rows of A up to k + upper only, so a new set is refactorised from
+  // its first index that differs, less the upper bandwidth.
+  void factor_active_set(const std::vector<int>& A) {
+    const auto a = static_cast<Index>(A.size());
+    const Index l = lcp_lower_, u = lcp_upper_, w = l + u + 1;
+    const Index common = std::min<Index>(a, static_cast<Index>(lu_set_.size()));
+    Index same = 0;
+    while (same < common && lu_set_[static_cast<std::size_t>(same)] == A[static_cast<std::size_t>(same)]) ++same;
+    if (same == a && static_cast<Index>(lu_set_.size()) == a) return;
+    lu_.resize(static_cast<std::size_t>(a * w));
+    for (Index k = std::max<Index>(0, same - u); k < a; ++k) {
+      double* row = lu_.data() + k * w;  // entry (k, c) at row[c - k + l]
+      const Index ik = A[static_cast<std::size_t>(k)];
+      for (Index c = k - l; c <= k + u; ++c) {
+        row[c - k + l] = c >= 0 && c < a ? lcp_.coeff(ik, A[static_cast<std::size_t>(c)]) : 0.0;
+      }
+      for (Index i = std::max<Index>(0, k - l); i < k; ++i) {
+        const double* ui = lu_.data() + i * w;  // U(i, c) at ui[c - i + l]
+        const double factor = row[i - k + l] / ui[l];
+        row[i - k + l] = factor;
+        if (factor == 0.0) continue;
+        const Index top = std::min(i + u, a - 1);
+        for (Index c = i + 1; c <= top; ++c) row[c - k + l] -= factor * ui[c - i + l];
+      }
+      if (!(row[l] > 0.0) || !std::isfinite(row[l])) {
+        lu_set_.clear();
+        throw DivergenceError(fmt::format(
+            "{}: the tangent map's active-set matrix has pivot {} (the LCP matrix is not a "
+            "P-matrix)",
+            kMethodName, row[l]));
+      }
+    }
+    lu_set_ = A;
+  }
+
+  // dz = 0 outside A, dz_A = M_AA⁻¹ (-dq_A) with the factors of factor_active_set(A), for
+  // minus_dq = -dq.
+  void solve_active_set(const std::vector<int>& A, const Vector& minus_dq, Vector& dz) {
+    const auto a = static_cast<Index>(A.size());
+    const Index l = lcp_lower_, u = lcp_upper_, w = l + u + 1;
+    t_rhs_.resize(static_cast<std::size_t>(a));
+    for (Index k = 0; k < a; ++k) {
+      const double* row = lu_.data() + k * w;
+      double y = minus_dq[A[static_cast<std::size_t>(k)]];
+      for (Index i = std::max<Index>(0, k - l); i < k; ++i) y -= row[i - k + l] * t_rhs_[static_cast<std::size_t>(i)];
+      t_rhs_[static_cast<std::size_t>(k)] = y;
+    }
+    for (Index k = a - 1; k >= 0; --k) {
+      const double* row = lu_.data() + k * w;
+      double y = t_rhs_[static_cast<std::size_t>(k)];
+      const Index top = std::min(k + u, a - 1);
+      for (Index c = k + 1; c <= top; ++c) y -= row[c - k + l] * t_rhs_[static_cast<std::size_t>(c)];
+      t_rhs_[static_cast<std::size_t>(k)] = y / row[l];
+    }
+    dz.setZero(m_);
+    for (Index k = 0; k < a; ++k) dz[A[static_cast<std::size_t>(k)]] = t_rhs_[static_cast<std::size_t>(k)];
   }
 
   // The hooks of ModeSeries (switching_pim_detail.hpp), which holds the Taylor recursion and the
@@ -425,6 +587,16 @@ class BandedStepper final : public SwitchingPim,
   Vector position_, velocity_;
   IntegratorStats stats_;
   SwitchingPimDiagnostics diagnostics_;
+
+  // advance_with_tangent: the step's LCP matrix and its bandwidths, the mode a step starts in and
+  // its touching springs, the band LU of M_AA for the active set lu_set_, and scratch.
+  BandedMatrix lcp_;
+  Index lcp_lower_ = 0, lcp_upper_ = 0;
+  Vector start_mode_;
+  std::vector<int> start_acting_, lu_set_;
+  std::vector<double> lu_, t_rhs_;
+  Vector t_x_, t_u_, t_y_, t_bar_, t_acc_, t_g_, t_p_, t_slope_, t_z_;
+  Vector t_half_ = Vector::Zero(n_);
 };
 
 }  // namespace

@@ -326,6 +326,26 @@ class Stepper final
         [this] { sync(); });
   }
 
+  // advance_to, and the tangent map of every step applied to `tangent` (see switching_pim.hpp).
+  void advance_with_tangent(double t_end, Matrix& tangent, const StepObserver& observer) override {
+    if (tangent.rows() != 2 * n_) {
+      throw InputError(fmt::format("tangent has {} rows; the state [x; x'] has {}", tangent.rows(),
+                                   2 * n_));
+    }
+    this->tangent_ = &tangent;
+    struct Release {
+      Stepper* s;
+      ~Release() { s->tangent_ = nullptr; }
+    } release{this};
+    detail::advance_on_grid(
+        t_end, time(), eta_, observer, position_, velocity_,
+        [this] {
+          step_with_tangent();
+          return time();
+        },
+        [this] { sync(); });
+  }
+
  private:
   struct Harmonic {
     double omega;
@@ -443,6 +463,144 @@ class Stepper final
     } else {
       step_direct();
     }
+  }
+
+  // One step and its tangent map. A switching step maps the tangent piece by piece as it goes
+  // (ModeSeries::tangent_piece); a smooth step is affine in the start state for the mode it
+  // starts in and the LCP's active set, and tangent_smooth_step() applies its linear part after it.
+  void step_with_tangent() {
+    const ModeOps* op = mode_cached_ ? &mode_ops() : nullptr;
+    start_mode_ = mode_;
+    const long before = diagnostics_.switching_steps;
+    step();
+    if (diagnostics_.switching_steps == before) tangent_smooth_step(op);
+  }
+
+  // The linear part of a smooth step applied to the tangent columns: the step's formula with the
+  // loads and the spring offsets left out, the force derivatives p_r of the start mode, and the
+  // LCP replaced by the linear solve on its active set A (the derivative of the LCP's solution
+  // where A is locally constant: dz_A = -M_AA⁻¹ dq_A, dz = 0 elsewhere). With the mode's
+  // operators (op) the part before the LCP is op->bar and op->gap, as in step_cached().
+  void tangent_smooth_step(const ModeOps* op) {
+    Matrix& Y = *this->tangent_;
+    if (Y.cols() == 0) return;
+    if constexpr (kModeCache) {
+      if (op != nullptr && o_.locate_switches && op->lcp_ready) {
+        tangent_smooth_cached(*op);
+        return;
+      }
+    }
+    const Index n = n_;
+    const Vector touching = Vector(start_mode_).cwiseProduct(Vector(stiffnesses_));
+    const auto last = d_ + (end_derivative_ ? 1 : 0);  // the last p_r the step uses
+    if (op != nullptr) {
+      t_bar_.noalias() = op->bar * Y;
+      if (end_derivative_) {
+        t_sum_.noalias() = static_cast<double>(d_ + 1) * (op->gap[static_cast<std::size_t>(d_ + 1)] * Y);
+        for (int r = 1; r <= d_; ++r) {
+          t_sum_.noalias() += static_cast<double>(r) * (op->gap[static_cast<std::size_t>(r)] * Y);
+        }
+        t_slope_.noalias() = touching.asDiagonal() * t_sum_;
+      }
+    } else {
+      t_x_ = Y.topRows(n);
+      t_u_ = Y.bottomRows(n);
+      t_bar_.noalias() = transition_ * Y;
+      if (end_derivative_) t_slope_.setZero(m_, Y.cols());
+      for (int r = 0; r <= last; ++r) {
+        t_sum_.noalias() = gap_rows_ * t_x_;
+        t_p_.noalias() = touching.asDiagonal() * t_sum_;
+        t_bar_.noalias() += correction_[static_cast<std::size_t>(r)] * t_p_;
+        if (end_derivative_ && r >= 1) t_slope_ += static_cast<double>(r) * t_p_;
+        if (r == last) break;
+        const double f = eta_ / (r + 1);
+        if (r < d_) {
+          t_acc_.noalias() = stiffness_part_ * t_x_;
+          t_acc_.noalias() += damping_part_ * t_u_;
+          t_acc_.noalias() += force_part_ * t_p_;
+        }
+        t_x_ = f * t_u_;
+        if (r < d_) t_u_ = f * t_acc_;
+      }
+    }
+    if (m_ > 0) {
+      // -dq = K2 W^T dbar_x.
+      t_q_.noalias() = spring_rows_ * t_bar_.topRows(n);
+      solve_active_set(t_q_, t_z_);
+      Y = t_bar_;
+      Y.noalias() += phi_ * t_z_;
+    } else {
+      Y = t_bar_;
+    }
+    if (end_derivative_ && o_.locate_switches && m_ > 0) {
+      // The end-slope correction, with the slope of the new state (same mode at both ends).
+      t_sum_.noalias() = gap_rows_ * Y.bottomRows(n);
+      t_slope_ = (eta_ * Vector(mode_).cwiseProduct(Vector(stiffnesses_))).asDiagonal() * t_sum_ -
+                 t_slope_;
+      Y.noalias() += slope_ * t_slope_;
+    }
+  }
+
+  // tangent_smooth_step() on the fixed sizes, column by column as step_cached() steps the state:
+  // the mode's operators, and the LCP's active set (the mode, when switches are located) solved
+  // by the mode's transform T_A (dz_A = (T_A dq)_A).
+  void tangent_smooth_cached(const ModeOps& op) {
+    Matrix& Y = *this->tangent_;
+    for (Index c = 0; c < Y.cols(); ++c) {
+      t_state_ = Y.col(c);
+      t_state_bar_.noalias() = mul(op.bar, t_state_);
+      if (end_derivative_) {
+        t_force_.noalias() = mul(op.gap[static_cast<std::size_t>(d_ + 1)], t_state_);
+        t_force_ *= static_cast<double>(d_ + 1);
+        for (int r = 1; r <= d_; ++r) {
+          t_force_sum_.noalias() = mul(op.gap[static_cast<std::size_t>(r)], t_state_);
+          t_force_ += static_cast<double>(r) * t_force_sum_;
+        }
+        t_force_ = op.touching.cwiseProduct(t_force_);
+      }
+      // -dq = K2 W^T dbar_x, and T_A(-dq) = -dz on the active set.
+      t_force_sum_.noalias() = mul(spring_rows_, upper(t_state_bar_, n_));
+      t_force_dz_.noalias() = mul(op.lcp_transform, t_force_sum_);
+      t_state_ = t_state_bar_;
+      for (Index j = 0; j < m_; ++j) {
+        if (mode_[j] > 0.0) t_state_ -= t_force_dz_[j] * phi_.col(j);
+      }
+      if (end_derivative_ && mode_mask_ != 0) {
+        t_force_sum_.noalias() = mul(op.slope_rows, lower(t_state_, n_));
+        t_force_ = t_force_sum_ - t_force_;
+        for (Index j = 0; j < m_; ++j) {
+          if (mode_[j] > 0.0) t_state_ += t_force_[j] * slope_.col(j);
+        }
+      }
+      Y.col(c) = t_state_;
+    }
+  }
+
+  // dz = 0 outside the last LCP's active set A = {z > 0}, dz_A = M_AA⁻¹ (-dq_A) for
+  // minus_dq = -dq; the LU of M_AA is kept until A changes.
+  void solve_active_set(const Matrix& minus_dq, Matrix& dz) {
+    active_.clear();
+    for (Index j = 0; j < m_; ++j) {
+      if (z_[j] > 0.0) active_.push_back(j);
+    }
+    const auto a = static_cast<Index>(active_.size());
+    if (!lu_valid_ || active_ != lu_active_) {
+      Matrix block(a, a);
+      for (Index i = 0; i < a; ++i) {
+        for (Index k = 0; k < a; ++k) {
+          block(i, k) = lcp_matrix_(active_[static_cast<std::size_t>(i)], active_[static_cast<std::size_t>(k)]);
+        }
+      }
+      if (a > 0) active_lu_.compute(block);
+      lu_active_ = active_;
+      lu_valid_ = true;
+    }
+    dz.setZero(m_, minus_dq.cols());
+    if (a == 0) return;
+    t_rhs_.resize(a, minus_dq.cols());
+    for (Index i = 0; i < a; ++i) t_rhs_.row(i) = minus_dq.row(active_[static_cast<std::size_t>(i)]);
+    t_sol_.noalias() = active_lu_.solve(t_rhs_);
+    for (Index i = 0; i < a; ++i) dz.row(active_[static_cast<std::size_t>(i)]) = t_sol_.row(i);
   }
 
   // The smooth step on the mode's combined operators: the same quantities as step_direct()
@@ -757,6 +915,16 @@ class Stepper final
   Phases phases_;  // sin ωt, cos ωt of the load group at the step start, and 1
   Force lcp_x_;
   Half scaled_velocity_;  // η x'
+
+  // advance_with_tangent: the mode a step starts in, the active set of the LU kept for the
+  // tangent's LCP solves, and scratch.
+  Force start_mode_;
+  std::vector<Index> active_, lu_active_;
+  Eigen::PartialPivLU<Matrix> active_lu_;
+  bool lu_valid_ = false;
+  Matrix t_bar_, t_x_, t_u_, t_acc_, t_p_, t_sum_, t_slope_, t_q_, t_z_, t_rhs_, t_sol_;
+  State t_state_, t_state_bar_;
+  Force t_force_, t_force_sum_, t_force_dz_;
 };
 
 template <int N>

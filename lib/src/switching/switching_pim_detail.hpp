@@ -177,6 +177,13 @@ class ModeSeries {
     vx_ = Half::Zero(n);
     vu_ = vx_;
     acc_ = vx_;
+    tx_ = vx_;
+    tu_ = vx_;
+    tsx_ = vx_;
+    tsu_ = vx_;
+    tacc_ = vx_;
+    tg_ = Force::Zero(m);
+    tp_ = tg_;
   }
 
   // Scaled Taylor coefficients of the motion in the current mode about time t for a step h, the
@@ -348,10 +355,12 @@ class ModeSeries {
       st.diagnostics_.gap_samples += r.samples;
       if (r.found) {
         evaluate_series(R, r.at.t);
+        if (tangent_ != nullptr) tangent_piece(h, R, r.at.t);
         s = r.at.t >= 1.0 && whole ? st.eta_ : s + r.at.t * h;
         for (Index j : r.springs) toggle(j);
       } else {
         evaluate_series(R, 1.0);
+        if (tangent_ != nullptr) tangent_piece(h, R, 1.0);
         s = whole ? st.eta_ : s + h;
       }
       xs_[0].swap(vx_);
@@ -359,6 +368,49 @@ class ModeSeries {
     }
     st.end_pieces();
     st.finish_step();
+  }
+
+  // The tangent map of one piece: the piece's end state is Σ_r a_r σ^r with the a_r of
+  // taylor(), affine in the piece's start; its linear part is the same recursion without the
+  // loads and the spring offsets K2 Δ (the mode is fixed inside the piece), applied to every
+  // column of *tangent_ (rows [x; x']) and summed at the same σ. The R terms of the state's series
+  // at least, more while the tangent's own terms are above rounding (a state whose series stops
+  // early by accident, at rest, say, must not truncate the tangent's). The dependence of σ on the
+  // start (a located switch) adds (f_old - f_new) dt*/dy to the next piece's start, where f_old
+  // and f_new are the two modes' vector fields at the switch: they differ by the switching
+  // spring's force K2 (w^T x - Δ), zero at the located root up to its tolerance, so that term is
+  // left out (no saltation for a continuous vector field).
+  void tangent_piece(double h, int R, double sigma) {
+    Stepper& st = self();
+    Matrix& Y = *tangent_;
+    const Index n = xs_[0].size();
+    const int limit = std::max(R, st.o_.max_series_terms);
+    constexpr double tol = 0.5 * kEpsilon;
+    for (Index c = 0; c < Y.cols(); ++c) {
+      tx_ = Y.col(c).head(n);
+      tu_ = Y.col(c).tail(n);
+      tsx_ = tx_;
+      tsu_ = tu_;
+      double largest = std::max(tx_.cwiseAbs().maxCoeff(), tu_.cwiseAbs().maxCoeff());
+      double previous = largest, power = 1.0;
+      for (int r = 0; r < limit; ++r) {
+        st.gap_product(tx_, tg_);
+        tp_ = st.mode_.cwiseProduct(st.stiffnesses_.cwiseProduct(tg_));
+        st.acceleration(tx_, tu_, tp_, tacc_);
+        const double f = h / (r + 1);
+        tx_ = f * tu_;
+        tu_ = f * tacc_;
+        power *= sigma;
+        tsx_ += power * tx_;
+        tsu_ += power * tu_;
+        const double size = std::max(tx_.cwiseAbs().maxCoeff(), tu_.cwiseAbs().maxCoeff());
+        largest = std::max(largest, size);
+        if (r + 1 >= R && r + 1 >= 4 && size + previous <= tol * largest) break;
+        previous = size;
+      }
+      Y.col(c).head(n) = tsx_;
+      Y.col(c).tail(n) = tsu_;
+    }
   }
 
   void toggle(Index j) {
@@ -372,6 +424,11 @@ class ModeSeries {
   std::vector<Force> ps_, gw_;
   Half vx_, vu_;  // the state a piece ends in
   Half acc_;      // scratch of taylor()
+  // advance_with_tangent: the tangent (2n x p, rows [x; x']) the pieces also map, null otherwise;
+  // scratch of tangent_piece().
+  Matrix* tangent_ = nullptr;
+  Half tx_, tu_, tsx_, tsu_, tacc_;
+  Force tg_, tp_;
   double phase_sin_[16] = {}, phase_cos_[16] = {}, load_scale_[16] = {};
   PolynomialGaps poly_;
   event_detail::EventLocator locator_;

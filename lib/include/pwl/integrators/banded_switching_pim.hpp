@@ -37,6 +37,13 @@
 // The numbers are those of the dense make_switching_pim up to the band's truncation (the
 // tolerance of BandedExponentialOptions, 1e-15 of each operator block by default) and rounding.
 //
+// Tangent map (advance_with_tangent): the dense stepper's (switching_pim.hpp), the derivative of
+// the numerical step map applied to p columns (2n x p, rows [x; x'], not interleaved), column by
+// column with the step's own banded and sparse products: a smooth step costs one product with T,
+// d + 1 sparse recursion terms and the touching springs' forces per column, the LCP's active-set
+// solve a band LU of M_AA (refactorised only from the first index where the active set changed),
+// and a piece of a switching step its Taylor terms; O(n q) per column and step, nothing 2n x 2n.
+//
 // References: W. X. Zhong and F. W. Williams, Proc. IMechE C 208 (1994) 427-430 (precise
 // integration); He Dongdong, Gao Qiang and Zhong Wanxie, Appl. Math. Mech. 39(7) (2018) 737-749
 // (the banded exponential of periodic structures); C. F. Van Loan, IEEE TAC 23 (1978) 395-404

@@ -80,6 +80,9 @@ struct MethodSettings {
   // setting and its value (a step that is not positive, a tolerance that is not, a structure
   // beyond the method's size limits).
   bool is_valid(const GapStructure& structure, std::string* why) const;
+  // These settings for a case of forcing period T: the step T / steps_per_period on a fixed grid
+  // (so that every forcing period ends on the grid), the largest step T/8 for an adaptive method.
+  MethodSettings for_period(double period, int steps_per_period) const;
 };
 
 // The method's label with the settings a reader needs to repeat the run: "PIM", "switching PIM",

@@ -47,6 +47,19 @@
 //      stepped over), the crossing springs change mode there, and the next piece starts. Only
 //      the switching steps (a few per cent of them) pay for this.
 //
+// Tangent map (advance_with_tangent): the exact derivative of the numerical step map, applied to
+// p tangent columns (2n x p, rows [x; x']); the motion is advance_to's to the last bit. With
+// the modes and the LCP's active set those of the trajectory, a smooth step is affine in its
+// start: its linear part is the same step with the loads and spring offsets left out and the LCP
+// replaced by the solve on its active set A (dz_A = -M_AA⁻¹ dq_A, the LCP solution's derivative
+// where A does not change). A switching step maps the tangent through each piece's homogeneous
+// Taylor series at the piece's σ. There is no saltation term: a located switch's time depends on
+// the start, but it enters only through the two modes' vector fields at the switch, which differ
+// by the switching spring's force K2 (w^T x - Δ), zero at the root (the force is continuous).
+// Central differences of the one-period map of figure 4a agree to about 3e-9, and the tangent
+// converges to the exact flow's Jacobian at order 5. A tangent column costs about one state
+// step; without a tangent nothing is added to a step.
+//
 // Costs: the smooth step is the plain step plus d products with H and the spring directions
 // and d+2 thin products; a switching step costs some tens of smooth steps, and there is about
 // one per spring switch. On figure 4a (η = T/200, five switches per period) the default costs

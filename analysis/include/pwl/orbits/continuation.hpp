@@ -1,0 +1,123 @@
+#pragma once
+// Continuation of a periodic orbit in a parameter, with its bifurcations located on the way.
+//
+// Pseudo-arclength continuation (H. B. Keller, in Applications of Bifurcation Theory, Academic
+// Press 1977, 359-384; E. L. Allgower and K. Georg, Introduction to Numerical Continuation Methods,
+// SIAM 2003, ch. 2) of the fixed points of the stroboscopic map,
+//
+//     F(y, p) = φ_{kT(p)}(y; p) − y = 0,
+//
+// in the unknowns (y, p): the branch is followed by its arclength, so it goes round a fold (where
+// the parameter turns back) as easily as elsewhere. A step predicts along the unit tangent τ of
+// the branch, (y, p) + h τ, and corrects by Newton on F = 0 with τ · ((y, p) − prediction) = 0,
+// whose bordered Jacobian [M − I, ∂F/∂p; τ^T] is regular at a fold. The monodromy M comes from the
+// map's exact tangent, ∂F/∂p from central differences of the map in p. The step grows after easy
+// corrections and shrinks after hard ones or a turn of the tangent by more than 30°.
+//
+// Bifurcations, between two accepted points, from the Floquet multipliers and the orbit's profile:
+//  - fold: a real multiplier crosses +1 (the parity of the real multipliers beyond +1 changes);
+//  - period doubling: a real multiplier crosses −1;
+//  - Neimark–Sacker: a complex pair crosses the unit circle (the count of complex multipliers
+//    outside it changes, and the count of all multipliers outside it by as much);
+//  - grazing: the largest (or smallest) value along the orbit of a gap function g_j passes through
+//    zero, so a contact appears or disappears. In a structure with continuous piecewise-linear
+//    forces the map stays C¹ there, but its multipliers may change at an unbounded rate
+//    (M. di Bernardo, C. J. Budd, A. R. Champneys and P. Kowalczyk, Piecewise-smooth Dynamical
+//    Systems, Springer 2008, ch. 6 and 8).
+// Each is located by the Illinois variant of regula falsi on the arclength between the two points
+// (every trial point corrected onto the branch) on a test function that vanishes there: the real
+// multiplier nearest ±1 minus ±1, the modulus of the complex pair nearest the circle minus 1, the
+// extreme gap. The parameter is located to `locate_tolerance`.
+//
+// Branch switching: at a period doubling of a period-k branch, the period-2k branch passes through
+// the same point with the tangent (v, 0), v the eigenvector of the multiplier −1 (Y. A. Kuznetsov,
+// Elements of Applied Bifurcation Theory, 3rd ed., Springer 2004, §10.3). It is started at
+// y* + ε v with the projection on v held fixed, checked to be a genuine period-2k orbit, and
+// followed like the first.
+//
+// Continuation forms the monodromy, so it is for structures the dense shooting solver takes
+// (ShootingOptions::dense_state_limit state components).
+#include <complex>
+#include <string>
+#include <vector>
+
+#include "pwl/orbits/orbit_profile.hpp"
+#include "pwl/orbits/periodic_orbit.hpp"
+#include "pwl/study/point_model.hpp"
+
+namespace pwl::orbits {
+
+enum class BifurcationType { fold, period_doubling, neimark_sacker, grazing };
+// "fold", "period-doubling", "neimark-sacker", "grazing".
+std::string bifurcation_name(BifurcationType type);
+
+struct BranchPoint {
+  int branch = 0;         // 0: the branch started from; 1, 2, ...: switched onto, in order
+  double parameter = 0.0;
+  double arclength = 0.0; // along its branch, from the branch's first point
+  PeriodicOrbit orbit;    // state, period, multipliers (no monodromy kept)
+  OrbitProfile profile;   // amplitudes and gap extremes
+};
+
+struct Bifurcation {
+  BifurcationType type = BifurcationType::fold;
+  int branch = 0;
+  int period = 1;             // of the branch it was found on
+  double parameter = 0.0;
+  Vector state;               // the orbit there
+  // fold, period doubling, Neimark–Sacker: the multiplier on the unit circle (as located).
+  std::complex<double> multiplier{0.0, 0.0};
+  // grazing: the spring (0-based), and whether it is the largest value of its gap function that
+  // passes through zero (a contact appears or disappears at the orbit's closest approach) or the
+  // smallest (a spring that never let go starts to).
+  int spring = -1;
+  bool at_largest_gap = true;
+  double test_value = 0.0;    // the test function where located (≈ 0)
+  int to_branch = -1;         // period doubling with branch switching: the branch it started
+};
+
+struct ContinuationOptions {
+  analysis::SweepParameter parameter;  // what varies (any parameter of the model)
+  double start = 0.0;                  // the branch starts here ...
+  double end = 1.0;                    // ... and is followed toward here
+  double initial_step = 0.0;  // arclength of the first step; 0: |end − start| / 100
+  double min_step = 0.0;      // 0: 1e-7 |end − start|
+  double max_step = 0.0;      // 0: |end − start| / 25
+  int max_points = 2000;      // per branch
+  int max_corrections = 7;    // Newton iterations of one corrector
+  double locate_tolerance = 1e-10;  // of the bifurcation parameters
+  bool grazing = true;              // detect grazing
+  bool switch_branches = false;     // follow the period-2k branch at each period doubling
+  int max_branches = 4;             // branches switched onto, in all
+  int profile_samples = 256;        // per period, methods off a fixed grid
+  // The method that integrates the map, and its steps per forcing period (fixed grid).
+  MethodSettings method{Method::exact};
+  int steps_per_period = 200;
+  ShootingOptions shooting;  // period k, tolerance, Newton at the first point
+  bool is_valid(std::string* why) const;
+};
+
+// Hooks for progress and for writing as the branch grows (every hook optional).
+class ContinuationObserver {
+ public:
+  virtual ~ContinuationObserver() = default;
+  virtual void point(const BranchPoint& /*point*/) {}
+  virtual void bifurcation(const Bifurcation& /*bifurcation*/) {}
+  // Why a branch stopped, or a branch switch that failed, for people.
+  virtual void note(const std::string& /*message*/) {}
+};
+
+struct ContinuationResult {
+  std::vector<BranchPoint> points;        // every branch, in the order computed
+  std::vector<Bifurcation> bifurcations;  // in the order found
+  std::vector<std::string> notes;         // why each branch stopped
+};
+
+// Follows the period-k orbit near `guess` (at p = start) toward `end`. Throws InputError for
+// invalid options, ShootingError when no orbit is found at the start; later failures stop the
+// branch with a note.
+ContinuationResult continue_periodic_orbit(const analysis::PointModel& model, const Vector& guess,
+                                           const ContinuationOptions& options,
+                                           ContinuationObserver* observer = nullptr);
+
+}  // namespace pwl::orbits

@@ -1,0 +1,59 @@
+#pragma once
+// Floquet multipliers: the eigenvalues of the monodromy matrix M = ∂φ_{kT}/∂y of a period-k orbit.
+// An orbit is asymptotically stable when every multiplier lies inside the unit circle, and it
+// loses stability where one leaves it: through +1 (a fold, or a branch point), through −1 (period
+// doubling), or as a complex pair (Neimark–Sacker, a torus is born). A forced system has no
+// trivial multiplier at 1 (there is no phase to shift), so all 2n count.
+//
+// For a small structure the monodromy is formed and all multipliers are its eigenvalues. For a
+// long chain only products M v are affordable (one integration of k periods with a tangent vector
+// each), and the leading few multipliers, those of largest modulus that decide stability, come
+// from Arnoldi's method with explicit restarts on those products (Y. Saad, Numerical Methods for
+// Large Eigenvalue Problems, 2nd ed., SIAM 2011, ch. 6; the use for periodic orbits after
+// K. Lust, D. Roose, A. Spence and A. R. Champneys, SIAM J. Sci. Comput. 19 (1998) 1188-1209).
+#include <complex>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "pwl/types.hpp"
+
+namespace pwl::orbits {
+
+struct FloquetMultipliers {
+  // Largest modulus first; complex pairs adjacent, the one with positive imaginary part first.
+  std::vector<std::complex<double>> values;
+  // All 2n multipliers (from the dense monodromy), or only the leading ones (Arnoldi).
+  bool complete = true;
+  // Arnoldi: the largest residual estimate of the reported values (0 for the dense ones).
+  double residual = 0.0;
+
+  double largest_modulus() const;
+  // Asymptotically stable: every multiplier strictly inside the unit circle by more than
+  // `margin`. (With the leading ones only, this is decided by the largest of them, which
+  // Arnoldi finds first.)
+  bool stable(double margin = 0.0) const;
+  // Multipliers outside the unit circle.
+  int unstable_count() const;
+};
+
+// All eigenvalues of a dense monodromy, sorted. Throws InputError for a non-square or non-finite
+// matrix.
+FloquetMultipliers floquet_multipliers(const Matrix& monodromy);
+
+struct ArnoldiOptions {
+  int count = 6;            // leading multipliers wanted
+  int krylov_dimension = 40;  // basis size per restart (> count)
+  int max_restarts = 20;
+  double tolerance = 1e-10;  // residual of a Ritz pair relative to max(|μ_1|, 1)
+  unsigned seed = 1;         // the starting vector (fixed: the answer is reproducible)
+  bool is_valid(std::string* why) const;
+};
+
+// The `count` multipliers of largest modulus of the operator `apply` (which replaces the columns of
+// its argument, size x p, by M times them) by restarted Arnoldi. `complete` is false unless count
+// reaches `size`. Throws InputError for invalid options.
+FloquetMultipliers leading_floquet_multipliers(const std::function<void(Matrix&)>& apply,
+                                               Index size, const ArnoldiOptions& options = {});
+
+}  // namespace pwl::orbits

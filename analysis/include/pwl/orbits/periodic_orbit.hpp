@@ -1,0 +1,106 @@
+#pragma once
+// Periodic orbits by shooting: Newton's method on the fixed-point equation of the stroboscopic map,
+//
+//     F(y) = φ_{kT}(y) − y = 0,
+//
+// for a period-k orbit, y = [x; x'] at t = 0 mod T. Newton needs J = M − I with the monodromy
+// M = ∂φ_{kT}/∂y, which the StroboscopicMap gives exactly for the methods with a tangent map (no
+// saltation term: the vector field is continuous).
+//
+// Linear algebra by size. A small structure forms M (2n tangent columns, one integration) and
+// solves J δ = −F by LU; its Floquet multipliers are then all the eigenvalues of the M of the last
+// iteration. A long chain never forms M: J δ = −F is solved by GMRES on products M v (one
+// integration of k periods with one tangent vector each; Y. Saad and M. H. Schultz, SIAM J. Sci.
+// Stat. Comput. 7 (1986) 856-869), to a relative residual that tightens as F shrinks (inexact
+// Newton, S. C. Eisenstat and H. F. Walker, SIAM J. Sci. Comput. 17 (1996) 16-32), and the leading
+// multipliers come from Arnoldi (floquet_multipliers.hpp).
+//
+// Multiple shooting. An orbit that is strongly unstable (|μ| ≫ 1) makes the single-shooting
+// Jacobian badly conditioned and its Newton basin tiny. With `shots` = m > 1 the k periods are cut
+// into m arcs of k/m periods each (m must divide k) or, for m = s·k, each period into s arcs of
+// T/s (the step grid must divide them), and the unknowns are the m arc starts y_i with
+// F_i = φ_{arc}(y_i) − y_{i+1 mod m} = 0 (block-cyclic Jacobian; U. M. Ascher, R. M. M. Mattheij
+// and R. D. Russell, Numerical Solution of Boundary Value Problems for ODEs, SIAM 1995, ch. 4).
+// Only the dense form supports it.
+//
+// Globalisation: a step that does not decrease |F| is halved (backtracking on the residual) down
+// to 1/64; Newton stops with a ShootingError that says the residual reached when it cannot go on.
+#include <string>
+#include <vector>
+
+#include "pwl/errors.hpp"
+#include "pwl/orbits/floquet_multipliers.hpp"
+#include "pwl/orbits/stroboscopic_map.hpp"
+
+namespace pwl::orbits {
+
+enum class ShootingSolver {
+  automatic,  // dense up to dense_state_limit state components, Krylov beyond
+  dense,      // form M, LU
+  krylov,     // GMRES on M v products, Arnoldi for the leading multipliers
+};
+
+struct ShootingOptions {
+  int period = 1;  // k: forcing periods per orbit
+  int shots = 1;   // arcs of multiple shooting (1: single shooting)
+  // Convergence: |F|_∞ <= tolerance · max(1, |y|_∞).
+  double tolerance = 1e-10;
+  int max_iterations = 40;
+  ShootingSolver solver = ShootingSolver::automatic;
+  Index dense_state_limit = 400;
+  // Krylov: basis size of GMRES per Newton step and restarts.
+  int gmres_dimension = 60;
+  int gmres_restarts = 4;
+  // Floquet multipliers: all for the dense form; the leading `floquet_count` for Krylov.
+  bool multipliers = true;
+  ArnoldiOptions arnoldi;
+  bool is_valid(std::string* why) const;
+};
+
+// "automatic", "dense", "krylov" and back (InputError naming the value otherwise).
+std::string shooting_solver_name(ShootingSolver solver);
+ShootingSolver parse_shooting_solver(const std::string& name);
+
+struct PeriodicOrbit {
+  Vector state;                  // y at t = 0 mod T, [x; x']
+  int period = 1;                // k
+  double forcing_period = 0.0;   // T
+  double residual = 0.0;         // |φ_{kT}(y) − y|_∞ at the answer
+  int iterations = 0;            // Newton iterations
+  long evaluations = 0;          // integrations of the map (k periods each, tangent included)
+  bool exact_tangent = true;     // multipliers from the exact tangent (else forward differences)
+  ShootingSolver solver = ShootingSolver::dense;  // the one used
+  FloquetMultipliers multipliers;
+  Matrix monodromy;              // M at the answer (dense form only; empty otherwise)
+
+  bool stable() const { return multipliers.stable(); }
+};
+
+// Newton did not converge: the message says why, with the residual reached.
+class ShootingError : public Error {
+ public:
+  ShootingError(const std::string& message, double residual, int iterations)
+      : Error(message), residual_(residual), iterations_(iterations) {}
+  double residual() const { return residual_; }
+  int iterations() const { return iterations_; }
+
+ private:
+  double residual_;
+  int iterations_;
+};
+
+// The period-k orbit near `guess` ([x; x'] at t = 0 mod T). Throws ShootingError when Newton does
+// not converge, InputError for invalid options or a guess of the wrong size, DivergenceError when
+// the motion from an iterate blows up.
+PeriodicOrbit find_periodic_orbit(StroboscopicMap& map, const Vector& guess,
+                                  const ShootingOptions& options = {});
+
+// The multipliers of the period-k orbit through `state` (no Newton): the dense monodromy or
+// Arnoldi, as `options` says.
+FloquetMultipliers orbit_multipliers(StroboscopicMap& map, const Vector& state,
+                                     const ShootingOptions& options, Matrix* monodromy = nullptr);
+
+// Whether the solver is dense for a map of this size.
+bool uses_dense_solver(const StroboscopicMap& map, const ShootingOptions& options);
+
+}  // namespace pwl::orbits

@@ -1,0 +1,751 @@
+#include "pwl/orbits/continuation.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <fmt/format.h>
+#include <limits>
+#include <map>
+#include <optional>
+
+namespace pwl::orbits {
+
+std::string bifurcation_name(BifurcationType type) {
+  switch (type) {
+    case BifurcationType::fold: return "fold";
+    case BifurcationType::period_doubling: return "period-doubling";
+    case BifurcationType::neimark_sacker: return "neimark-sacker";
+    case BifurcationType::grazing: return "grazing";
+  }
+  return "?";
+}
+
+bool ContinuationOptions::is_valid(std::string* why) const {
+  std::string scratch;
+  if (why == nullptr) why = &scratch;
+  if (!std::isfinite(start) || !std::isfinite(end) || start == end) {
+    *why = fmt::format("range {}:{} must be two different finite values", start, end);
+    return false;
+  }
+  for (const auto& [name, value] : {std::pair{"initial step", initial_step},
+                                    std::pair{"min step", min_step},
+                                    std::pair{"max step", max_step}}) {
+    if (!(value >= 0) || !std::isfinite(value)) {
+      *why = fmt::format("{} = {} must be >= 0 and finite (0: the default)", name, value);
+      return false;
+    }
+  }
+  if (max_points < 2) {
+    *why = fmt::format("max points = {} must be >= 2", max_points);
+    return false;
+  }
+  if (max_corrections < 2) {
+    *why = fmt::format("max corrections = {} must be >= 2", max_corrections);
+    return false;
+  }
+  if (!(locate_tolerance > 0) || !std::isfinite(locate_tolerance)) {
+    *why = fmt::format("locate tolerance = {} must be positive and finite", locate_tolerance);
+    return false;
+  }
+  if (max_branches < 0) {
+    *why = fmt::format("max branches = {} must be >= 0", max_branches);
+    return false;
+  }
+  if (profile_samples < 8) {
+    *why = fmt::format("profile samples = {} must be >= 8", profile_samples);
+    return false;
+  }
+  if (method_traits(method.method).fixed_grid && steps_per_period < 1) {
+    *why = fmt::format("steps per period = {} must be >= 1", steps_per_period);
+    return false;
+  }
+  if (shooting.shots != 1) {
+    *why = fmt::format("shots = {}: continuation uses single shooting", shooting.shots);
+    return false;
+  }
+  if (shooting.solver == ShootingSolver::krylov) {
+    *why = "solver = krylov: continuation forms the monodromy (dense solver)";
+    return false;
+  }
+  return shooting.is_valid(why);
+}
+
+namespace {
+
+constexpr double kRealTolerance = 1e-9;  // |Im μ| below this (relative) counts as real
+
+bool is_real(const std::complex<double>& mu) {
+  return std::abs(mu.imag()) <= kRealTolerance * std::max(1.0, std::abs(mu));
+}
+
+// What the multipliers say about stability, by kind.
+struct Signature {
+  int real_above_one = 0;     // real μ > 1
+  int real_below_minus_one = 0;
+  int complex_outside = 0;    // complex μ with |μ| > 1
+  int outside = 0;            // all with |μ| > 1
+};
+
+Signature signature(const FloquetMultipliers& mu) {
+  Signature s;
+  for (const auto& m : mu.values) {
+    if (std::abs(m) > 1) ++s.outside;
+    if (is_real(m)) {
+      if (m.real() > 1) ++s.real_above_one;
+      if (m.real() < -1) ++s.real_below_minus_one;
+    } else if (std::abs(m) > 1) {
+      ++s.complex_outside;
+    }
+  }
+  return s;
+}
+
+// The test functions of each kind of bifurcation at one point (NaN: none of that kind there).
+double nearest_real(const FloquetMultipliers& mu, double target) {
+  double best = std::numeric_limits<double>::quiet_NaN();
+  for (const auto& m : mu.values) {
+    if (!is_real(m)) continue;
+    if (std::isnan(best) || std::abs(m.real() - target) < std::abs(best - target)) best = m.real();
+  }
+  return best;
+}
+
+std::complex<double> nearest_complex_to_circle(const FloquetMultipliers& mu) {
+  std::complex<double> best{std::numeric_limits<double>::quiet_NaN(), 0};
+  for (const auto& m : mu.values) {
+    if (is_real(m)) continue;
+    if (std::isnan(best.real()) || std::abs(std::abs(m) - 1) < std::abs(std::abs(best) - 1)) {
+      best = m;
+    }
+  }
+  if (best.imag() < 0) best = std::conj(best);
+  return best;
+}
+
+// Re Π (μ_i − target): det(M − target I).
+double product_shifted(const FloquetMultipliers& mu, double target) {
+  std::complex<double> product{1.0, 0.0};
+  for (const auto& m : mu.values) product *= m - target;
+  return product.real();
+}
+
+// A point being built: (y, p) and what was computed there.
+struct Point {
+  Vector y;   // state
+  double p = 0.0;
+  Matrix M;   // monodromy
+  FloquetMultipliers mu;
+  Vector b;   // ∂F/∂p
+  Vector tangent;  // unit tangent (y, p), oriented along the branch
+  std::optional<OrbitProfile> profile;
+  double residual = 0.0;
+  int iterations = 0;
+};
+
+class Continuer {
+ public:
+  Continuer(const analysis::PointModel& model, const ContinuationOptions& options,
+            ContinuationObserver* observer, ContinuationResult& result)
+      : model_(model), options_(options), observer_(observer), result_(result) {
+    const double range = std::abs(options.end - options.start);
+    initial_step_ = options.initial_step > 0 ? options.initial_step : range / 100;
+    min_step_ = options.min_step > 0 ? options.min_step : 1e-7 * range;
+    max_step_ = options.max_step > 0 ? options.max_step : range / 25;
+    lo_ = std::min(options.start, options.end);
+    hi_ = std::max(options.start, options.end);
+  }
+
+  void run(const Vector& guess) {
+    // The first point: Newton at fixed p = start.
+    StroboscopicMap& map = map_at(options_.start);
+    if (map.state_size() > options_.shooting.dense_state_limit) {
+      throw InputError(fmt::format(
+          "continuation forms the {}x{} monodromy; the dense limit is {} state components",
+          map.state_size(), map.state_size(), options_.shooting.dense_state_limit));
+    }
+    ShootingOptions shooting = options_.shooting;
+    shooting.solver = ShootingSolver::dense;
+    const PeriodicOrbit orbit = find_periodic_orbit(map, guess, shooting);
+    Point first;
+    first.y = orbit.state;
+    first.p = options_.start;
+    first.M = orbit.monodromy;
+    first.mu = orbit.multipliers;
+    first.residual = orbit.residual;
+    first.iterations = orbit.iterations;
+    first.b = parameter_derivative(first.y, first.p, options_.shooting.period);
+    // The first tangent: (M − I) z_y = −b z_p with z_p = 1, pointing toward `end`.
+    const Index N = first.y.size();
+    Eigen::PartialPivLU<Matrix> lu(first.M - Matrix::Identity(N, N));
+    Vector z(N + 1);
+    z.head(N) = lu.solve(-first.b);
+    z(N) = 1.0;
+    if (!z.allFinite()) {
+      throw InputError(fmt::format(
+          "the orbit at {} = {} has a multiplier at 1: start the continuation elsewhere",
+          options_.parameter.name(), options_.start));
+    }
+    z /= z.norm();
+    if ((options_.end - options_.start) * z(N) < 0) z = -z;
+    first.tangent = z;
+    follow(std::move(first), 0, options_.shooting.period, 0, kNone);
+    while (!pending_.empty() && branches_ < options_.max_branches) {
+      Pending next = std::move(pending_.front());
+      pending_.pop_front();
+      switch_branch(next);
+    }
+  }
+
+ private:
+  struct Pending {
+    Point at;      // the period-doubling point on the period-k branch
+    int period = 1;
+    std::size_t bifurcation = 0;  // its index in result_.bifurcations
+  };
+
+  StroboscopicMap& map_at(double p) {
+    auto it = maps_.find(p);
+    if (it != maps_.end()) return it->second;
+    if (maps_.size() > 8) maps_.clear();
+    const analysis::PointModel model = model_.with(options_.parameter, p);
+    return maps_.emplace(p, StroboscopicMap(model.point_case(), options_.method,
+                                            options_.steps_per_period))
+        .first->second;
+  }
+
+  Vector residual(const Vector& y, double p, int period, Matrix* M) {
+    StroboscopicMap& map = map_at(p);
+    if (M != nullptr) return map.advance_with_jacobian(y, period, *M) - y;
+    return map.advance(y, period) - y;
+  }
+
+  Vector parameter_derivative(const Vector& y, double p, int period) {
+    const double delta = 1e-6 * std::max(1.0, std::abs(p));
+    const Vector plus = residual(y, p + delta, period, nullptr);
+    const Vector minus = residual(y, p - delta, period, nullptr);
+    return (plus - minus) / (2 * delta);
+  }
+
+  // Newton on F(y, p) = 0 with τ · ((y, p) − prediction) = 0 from the prediction. `b` is ∂F/∂p
+  // near the prediction (kept fixed: the chord in that column only).
+  std::optional<Point> correct(const Vector& y_pred, double p_pred, const Vector& tau,
+                               const Vector& b, int period) {
+    const Index N = y_pred.size();
+    Point pt;
+    pt.y = y_pred;
+    pt.p = p_pred;
+    for (int it = 0; it <= options_.max_corrections; ++it) {
+      Vector F;
+      try {
+        F = residual(pt.y, pt.p, period, &pt.M);
+      } catch (const Error&) {
+        return std::nullopt;  // the motion blew up or the structure became invalid
+      }
+      if (!F.allFinite()) return std::nullopt;
+      const double res = F.lpNorm<Eigen::Infinity>();
+      const double scale = std::max(1.0, pt.y.lpNorm<Eigen::Infinity>());
+      if (res <= options_.shooting.tolerance * scale) {
+        pt.residual = res;
+        pt.iterations = it;
+        pt.mu = floquet_multipliers(pt.M);
+        return pt;
+      }
+      if (it == options_.max_corrections) return std::nullopt;
+      Matrix A(N + 1, N + 1);
+      A.topLeftCorner(N, N) = pt.M - Matrix::Identity(N, N);
+      A.topRightCorner(N, 1) = b;
+      A.bottomRows(1) = tau.transpose();
+      Vector rhs(N + 1);
+      rhs.head(N) = -F;
+      rhs(N) = -(tau.head(N).dot(pt.y - y_pred) + tau(N) * (pt.p - p_pred));
+      const Vector d = Eigen::PartialPivLU<Matrix>(A).solve(rhs);
+      if (!d.allFinite()) return std::nullopt;
+      pt.y += d.head(N);
+      pt.p += d(N);
+      if (!std::isfinite(pt.p)) return std::nullopt;
+      std::string why;
+      if (!model_.accepts(options_.parameter, pt.p, &why)) return std::nullopt;
+    }
+    return std::nullopt;
+  }
+
+  // The tangent at a corrected point, oriented like `previous`.
+  Vector tangent_at(const Point& pt, const Vector& previous) {
+    const Index N = pt.y.size();
+    Matrix A(N + 1, N + 1);
+    A.topLeftCorner(N, N) = pt.M - Matrix::Identity(N, N);
+    A.topRightCorner(N, 1) = pt.b;
+    A.bottomRows(1) = previous.transpose();
+    Vector rhs = Vector::Zero(N + 1);
+    rhs(N) = 1.0;
+    Vector z = Eigen::PartialPivLU<Matrix>(A).solve(rhs);
+    z /= z.norm();
+    if (z.dot(previous) < 0) z = -z;
+    return z;
+  }
+
+  const OrbitProfile& profile_of(Point& pt, int period) {
+    if (!pt.profile) {
+      pt.profile = orbit_profile(map_at(pt.p), pt.y, period, options_.profile_samples);
+    }
+    return *pt.profile;
+  }
+
+  BranchPoint branch_point(Point& pt, int branch, int period, double arclength) {
+    BranchPoint bp;
+    bp.branch = branch;
+    bp.parameter = pt.p;
+    bp.arclength = arclength;
+    bp.orbit.state = pt.y;
+    bp.orbit.period = period;
+    bp.orbit.forcing_period = map_at(pt.p).forcing_period();
+    bp.orbit.residual = pt.residual;
+    bp.orbit.iterations = pt.iterations;
+    bp.orbit.exact_tangent = map_at(pt.p).exact_tangent();
+    bp.orbit.solver = ShootingSolver::dense;
+    bp.orbit.multipliers = pt.mu;
+    bp.profile = profile_of(pt, period);
+    return bp;
+  }
+
+  void note(std::string message) {
+    if (observer_ != nullptr) observer_->note(message);
+    result_.notes.push_back(std::move(message));
+  }
+
+  // Follows one branch from its first point.
+  // Follows one branch from its first point. A branch switched onto at a period doubling of a
+  // period-`parent_period` branch stops where it rejoins that branch (its orbits become
+  // period-`parent_period` ones: another period doubling of the parent) or closes on itself.
+  static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+  void follow(Point first, int branch, int period, int parent_period, std::size_t source) {
+    const std::string label = fmt::format("branch {} (period {})", branch, period);
+    const Vector first_y = first.y;
+    const double first_p = first.p;
+    Point current = std::move(first);
+    double arclength = 0;
+    {
+      BranchPoint bp = branch_point(current, branch, period, arclength);
+      emit(bp);
+    }
+    double h = initial_step_;
+    int points = 1;
+    const double margin = 1e-9 * (hi_ - lo_);
+    while (true) {
+      if (points >= options_.max_points) {
+        note(fmt::format("{}: stopped after {} points (max points)", label, points));
+        return;
+      }
+      if (h < min_step_) {
+        note(fmt::format("{}: stopped at {} = {:.10g}: the step fell below {:.3g} (no orbit found "
+                         "ahead)",
+                         label, options_.parameter.name(), current.p, min_step_));
+        return;
+      }
+      const Index N = current.y.size();
+      const Vector y_pred = current.y + h * current.tangent.head(N);
+      const double p_pred = current.p + h * current.tangent(N);
+      std::optional<Point> next = correct(y_pred, p_pred, current.tangent, current.b, period);
+      if (!next) {
+        h /= 2;
+        continue;
+      }
+      next->b = parameter_derivative(next->y, next->p, period);
+      next->tangent = tangent_at(*next, current.tangent);
+      if (next->tangent.dot(current.tangent) < std::cos(30.0 * 3.141592653589793 / 180) &&
+          h > 4 * min_step_) {
+        h /= 2;
+        continue;
+      }
+      if (parent_period > 0 && rejoins(current, *next, h, parent_period, source, branch)) {
+        note(fmt::format("{}: rejoined the period-{} branch at its period doubling near {} = "
+                         "{:.10g} after {} points",
+                         label, parent_period, options_.parameter.name(), next->p, points));
+        return;
+      }
+      if (parent_period > 0) {
+        Vector Fk;
+        try {
+          Fk = residual(next->y, next->p, parent_period, nullptr);
+        } catch (const Error&) {
+          Fk = Vector::Constant(1, std::numeric_limits<double>::infinity());
+        }
+        if (Fk.lpNorm<Eigen::Infinity>() <=
+            1e3 * options_.shooting.tolerance * std::max(1.0, next->y.lpNorm<Eigen::Infinity>())) {
+          note(fmt::format("{}: rejoined the period-{} branch near {} = {:.10g} (a period "
+                           "doubling of it) after {} points",
+                           label, parent_period, options_.parameter.name(), current.p, points));
+          return;
+        }
+      }
+      if (points > 10) {
+        Vector gap(N + 1);
+        gap.head(N) = next->y - first_y;
+        gap(N) = next->p - first_p;
+        if (gap.norm() < h) {
+          note(fmt::format("{}: closed on itself after {} points", label, points));
+          return;
+        }
+      }
+      arclength += h;
+      ++points;
+      detect(current, *next, h, branch, period);
+      BranchPoint bp = branch_point(*next, branch, period, arclength);
+      emit(bp);
+      const int iterations = next->iterations;
+      current = std::move(*next);
+      if (current.p > hi_ + margin || current.p < lo_ - margin) {
+        note(fmt::format("{}: left the range at {} = {:.10g} after {} points", label,
+                         options_.parameter.name(), current.p, points));
+        return;
+      }
+      if (iterations <= 2) h = std::min(1.5 * h, max_step_);
+      if (iterations >= 5) h *= 0.6;
+    }
+  }
+
+  // Whether the step from a to b passes through a period doubling of the parent branch other than
+  // the one the branch started from (then the branch goes on as the parent's orbits, or as the
+  // other half of the same loop). That period doubling is marked as switched onto this branch.
+  bool rejoins(const Point& a, const Point& b, double h, int parent_period, std::size_t source,
+               int branch) {
+    const Index N = a.y.size();
+    Vector ab(N + 1);
+    ab.head(N) = b.y - a.y;
+    ab(N) = b.p - a.p;
+    const double length2 = ab.squaredNorm();
+    for (std::size_t i = 0; i < result_.bifurcations.size(); ++i) {
+      Bifurcation& bif = result_.bifurcations[i];
+      if (bif.type != BifurcationType::period_doubling || bif.period != parent_period ||
+          i == source) {
+        continue;
+      }
+      Vector ap(N + 1);
+      ap.head(N) = bif.state - a.y;
+      ap(N) = bif.parameter - a.p;
+      const double w = length2 > 0 ? std::clamp(ap.dot(ab) / length2, 0.0, 1.0) : 0.0;
+      const double distance = (ap - w * ab).norm();
+      if (distance <= std::max(0.25 * h, 1e-7)) {
+        if (bif.to_branch < 0) bif.to_branch = branch;
+        std::erase_if(pending_, [&](const Pending& p) { return p.bifurcation == i; });
+        return true;
+      }
+    }
+    return false;
+  }
+
+  void emit(const BranchPoint& bp) {
+    if (observer_ != nullptr) observer_->point(bp);
+    result_.points.push_back(bp);
+  }
+
+  // The bifurcations between two consecutive points a and b (b predicted from a with step h
+  // along a's tangent), located and recorded.
+  void detect(Point& a, Point& b, double h, int branch, int period) {
+    const Signature sa = signature(a.mu), sb = signature(b.mu);
+    std::vector<std::pair<BifurcationType, int>> found;  // type, spring (grazing) * 2 + which
+    if ((sa.real_above_one - sb.real_above_one) % 2 != 0) found.emplace_back(BifurcationType::fold, -1);
+    if ((sa.real_below_minus_one - sb.real_below_minus_one) % 2 != 0) {
+      found.emplace_back(BifurcationType::period_doubling, -1);
+    }
+    if (sa.complex_outside != sb.complex_outside &&
+        sa.outside - sb.outside == sa.complex_outside - sb.complex_outside) {
+      found.emplace_back(BifurcationType::neimark_sacker, -1);
+    }
+    if (options_.grazing) {
+      const OrbitProfile& pa = profile_of(a, period);
+      const OrbitProfile& pb = profile_of(b, period);
+      for (Index j = 0; j < pa.max_gap.size(); ++j) {
+        if ((pa.max_gap(j) > 0) != (pb.max_gap(j) > 0)) {
+          found.emplace_back(BifurcationType::grazing, static_cast<int>(2 * j));
+        }
+        if ((pa.min_gap(j) > 0) != (pb.min_gap(j) > 0)) {
+          found.emplace_back(BifurcationType::grazing, static_cast<int>(2 * j + 1));
+        }
+      }
+    }
+    for (const auto& [type, which] : found) locate(a, b, h, type, which, branch, period);
+  }
+
+  // `variant` picks among the test functions of one kind: the first one whose signs differ at the
+  // two ends of the bracket is used.
+  static constexpr int kVariants = 2;
+  double test_function(Point& pt, BifurcationType type, int which, int period, int variant) {
+    if (variant == 1) {
+      switch (type) {
+        case BifurcationType::fold: return nearest_real(pt.mu, 1.0) - 1.0;
+        case BifurcationType::period_doubling: return nearest_real(pt.mu, -1.0) + 1.0;
+        case BifurcationType::neimark_sacker: {
+          double product = 1.0;
+          for (const auto& m : pt.mu.values) {
+            if (!is_real(m) && m.imag() > 0) product *= std::norm(m) - 1.0;
+          }
+          return product;
+        }
+        case BifurcationType::grazing: break;
+      }
+    }
+    switch (type) {
+      // det(M − I) and det(M + I) = Π (μ_i ± 1): continuous, and of opposite signs on the two
+      // sides of an odd number of real crossings of ±1 (which the detection saw), whichever
+      // multiplier crosses, and however fast near a grazing.
+      case BifurcationType::fold: return product_shifted(pt.mu, 1.0);
+      case BifurcationType::period_doubling: return product_shifted(pt.mu, -1.0);
+      // The modulus of the complex pair nearest the circle, less 1 (the second variant: Π over
+      // the complex pairs of (|μ|² − 1), which changes sign where one pair crosses).
+      case BifurcationType::neimark_sacker: return std::abs(nearest_complex_to_circle(pt.mu)) - 1.0;
+      case BifurcationType::grazing: {
+        const OrbitProfile& prof = profile_of(pt, period);
+        return which % 2 == 0 ? prof.max_gap(which / 2) : prof.min_gap(which / 2);
+      }
+    }
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+
+  void locate(Point& a, Point& b, double h, BifurcationType type, int which, int branch,
+              int period) {
+    const Index N = a.y.size();
+    double sa = 0, sb = h;
+    int variant = 0;
+    double fa = test_function(a, type, which, period, 0);
+    double fb = test_function(b, type, which, period, 0);
+    for (int v = 1; v < kVariants && !(std::isfinite(fa) && std::isfinite(fb) && fa * fb <= 0);
+         ++v) {
+      if (type == BifurcationType::grazing) break;
+      variant = v;
+      fa = test_function(a, type, which, period, v);
+      fb = test_function(b, type, which, period, v);
+    }
+    Point best = fabs_less(fa, fb) ? a : b;
+    double fbest = fabs_less(fa, fb) ? fa : fb;
+    double pa = a.p, pb = b.p;
+    Vector ya = a.y, yb = b.y;
+    bool located = std::isfinite(fa) && std::isfinite(fb) && fa * fb <= 0;
+    int side = 0;  // Illinois: which end was kept last
+    for (int it = 0; located && it < 80; ++it) {
+      if (std::abs(pb - pa) <= options_.locate_tolerance && std::abs(sb - sa) <= 1e-6 * h) break;
+      if (std::abs(sb - sa) <= 1e-13 * h) break;
+      double s = sb - fb * (sb - sa) / (fb - fa);
+      if (!(s > std::min(sa, sb) && s < std::max(sa, sb))) s = 0.5 * (sa + sb);
+      // Predict by interpolating the bracket's ends, constrain to a's tangent at arclength s.
+      const double w = (s - sa) / (sb - sa);
+      const Vector y_guess = (1 - w) * ya + w * yb;
+      const double p_guess = (1 - w) * pa + w * pb;
+      const Vector y_pred = a.y + s * a.tangent.head(N);
+      const double p_pred = a.p + s * a.tangent(N);
+      std::optional<Point> pt = correct_from(y_guess, p_guess, y_pred, p_pred, a.tangent, a.b,
+                                             period);
+      if (!pt) {
+        located = false;
+        break;
+      }
+      const double f = test_function(*pt, type, which, period, variant);
+      if (!std::isfinite(f)) {
+        located = false;
+        break;
+      }
+      if (std::abs(f) < std::abs(fbest)) {
+        best = *pt;
+        fbest = f;
+      }
+      if (f * fb < 0) {
+        sa = sb, fa = fb, pa = pb, ya = yb;
+        side = 0;
+      } else {
+        if (side == 1) fa /= 2;  // Illinois
+        side = 1;
+      }
+      sb = s, fb = f, pb = pt->p, yb = pt->y;
+      if (f == 0) break;
+    }
+    Bifurcation bif;
+    bif.type = type;
+    bif.branch = branch;
+    bif.period = period;
+    bif.parameter = best.p;
+    bif.state = best.y;
+    bif.test_value = fbest;
+    if (type == BifurcationType::fold) bif.multiplier = nearest_real(best.mu, 1.0);
+    if (type == BifurcationType::period_doubling) bif.multiplier = nearest_real(best.mu, -1.0);
+    if (type == BifurcationType::neimark_sacker) bif.multiplier = nearest_complex_to_circle(best.mu);
+    if (type == BifurcationType::grazing) {
+      bif.spring = which / 2;
+      bif.at_largest_gap = which % 2 == 0;
+    }
+    if (!located) {
+      note(fmt::format("{} near {} = {:.10g} on branch {}: detected, not located (bracket {:.10g} "
+                       "to {:.10g})",
+                       bifurcation_name(type), options_.parameter.name(), best.p, branch, a.p,
+                       b.p));
+    }
+    result_.bifurcations.push_back(bif);
+    if (observer_ != nullptr) observer_->bifurcation(bif);
+    if (type == BifurcationType::period_doubling && options_.switch_branches && located) {
+      pending_.push_back({best, period, result_.bifurcations.size() - 1});
+    }
+  }
+
+  static bool fabs_less(double x, double y) {
+    if (!std::isfinite(y)) return true;
+    if (!std::isfinite(x)) return false;
+    return std::abs(x) < std::abs(y);
+  }
+
+  // correct() started from a guess other than the prediction.
+  std::optional<Point> correct_from(const Vector& y_guess, double p_guess, const Vector& y_pred,
+                                    double p_pred, const Vector& tau, const Vector& b,
+                                    int period) {
+    // Shift the constraint so that the guess is the "prediction" plane's point: solve with the
+    // constraint τ · ((y, p) − (y_pred, p_pred)) = 0 starting from the guess.
+    const Index N = y_guess.size();
+    Point pt;
+    pt.y = y_guess;
+    pt.p = p_guess;
+    for (int it = 0; it <= options_.max_corrections + 3; ++it) {
+      Vector F;
+      try {
+        F = residual(pt.y, pt.p, period, &pt.M);
+      } catch (const Error&) {
+        return std::nullopt;
+      }
+      if (!F.allFinite()) return std::nullopt;
+      const double res = F.lpNorm<Eigen::Infinity>();
+      const double constraint = tau.head(N).dot(pt.y - y_pred) + tau(N) * (pt.p - p_pred);
+      const double scale = std::max(1.0, pt.y.lpNorm<Eigen::Infinity>());
+      if (res <= options_.shooting.tolerance * scale && std::abs(constraint) <= 1e-12 * scale) {
+        pt.residual = res;
+        pt.iterations = it;
+        pt.mu = floquet_multipliers(pt.M);
+        return pt;
+      }
+      Matrix A(N + 1, N + 1);
+      A.topLeftCorner(N, N) = pt.M - Matrix::Identity(N, N);
+      A.topRightCorner(N, 1) = b;
+      A.bottomRows(1) = tau.transpose();
+      Vector rhs(N + 1);
+      rhs.head(N) = -F;
+      rhs(N) = -constraint;
+      const Vector d = Eigen::PartialPivLU<Matrix>(A).solve(rhs);
+      if (!d.allFinite()) return std::nullopt;
+      pt.y += d.head(N);
+      pt.p += d(N);
+      std::string why;
+      if (!std::isfinite(pt.p) || !model_.accepts(options_.parameter, pt.p, &why)) {
+        return std::nullopt;
+      }
+    }
+    return std::nullopt;
+  }
+
+  void switch_branch(Pending& pd) {
+    const int period = 2 * pd.period;
+    const Index N = pd.at.y.size();
+    // The eigenvector of the multiplier nearest −1.
+    Eigen::EigenSolver<Matrix> eig(pd.at.M);
+    Index k = 0;
+    for (Index i = 1; i < eig.eigenvalues().size(); ++i) {
+      if (std::abs(eig.eigenvalues()(i) + 1.0) < std::abs(eig.eigenvalues()(k) + 1.0)) k = i;
+    }
+    Vector v = eig.eigenvectors().col(k).real();
+    v /= v.norm();
+    Vector tau0 = Vector::Zero(N + 1);
+    tau0.head(N) = v;
+    const double scale = std::max(1.0, pd.at.y.norm());
+    const Vector b0 = parameter_derivative(pd.at.y, pd.at.p, period);
+    for (double eps : {1e-3, 1e-2, 3e-2, 1e-4}) {
+      const Vector y_pred = pd.at.y + eps * scale * v;
+      std::optional<Point> pt = correct_from(y_pred, pd.at.p, y_pred, pd.at.p, tau0, b0, period);
+      if (!pt) continue;
+      // A genuine period-2k orbit: not a fixed point of the period-k map.
+      Vector Fk;
+      try {
+        Fk = residual(pt->y, pt->p, pd.period, nullptr);
+      } catch (const Error&) {
+        continue;
+      }
+      if (Fk.lpNorm<Eigen::Infinity>() <=
+          1e3 * options_.shooting.tolerance * std::max(1.0, pt->y.lpNorm<Eigen::Infinity>())) {
+        continue;
+      }
+      pt->b = parameter_derivative(pt->y, pt->p, period);
+      pt->tangent = tangent_at(*pt, tau0);
+      ++branches_;
+      result_.bifurcations[pd.bifurcation].to_branch = branches_;
+      follow(std::move(*pt), branches_, period, pd.period, pd.bifurcation);
+      return;
+    }
+    // Second way: Newton at a fixed parameter a little to either side of the period doubling,
+    // from y* ± ε v (the doubled orbit's size grows like the square root of the distance).
+    const double range = hi_ - lo_;
+    ShootingOptions shooting = options_.shooting;
+    shooting.period = period;
+    shooting.solver = ShootingSolver::dense;
+    for (double delta : {1e-4 * range, 1e-3 * range, 1e-2 * range}) {
+      for (double side : {1.0, -1.0}) {
+        const double p = pd.at.p + side * delta;
+        std::string why;
+        if (p < lo_ || p > hi_ || !model_.accepts(options_.parameter, p, &why)) continue;
+        for (double eps : {1.0, 3.0, 10.0, 30.0}) {
+          const Vector guess = pd.at.y + eps * std::sqrt(delta) * scale * v;
+          Point pt;
+          try {
+            const PeriodicOrbit orbit = find_periodic_orbit(map_at(p), guess, shooting);
+            pt.y = orbit.state;
+            pt.M = orbit.monodromy;
+            pt.mu = orbit.multipliers;
+            pt.residual = orbit.residual;
+            pt.iterations = orbit.iterations;
+            const Vector Fk = residual(pt.y, p, pd.period, nullptr);
+            if (Fk.lpNorm<Eigen::Infinity>() <=
+                1e3 * options_.shooting.tolerance * std::max(1.0, pt.y.lpNorm<Eigen::Infinity>())) {
+              continue;  // the period-k orbit again
+            }
+          } catch (const Error&) {
+            continue;
+          }
+          pt.p = p;
+          pt.b = parameter_derivative(pt.y, pt.p, period);
+          Vector away(N + 1);
+          away.head(N) = pt.y - pd.at.y;
+          away(N) = pt.p - pd.at.p;
+          pt.tangent = tangent_at(pt, away / away.norm());
+          ++branches_;
+          result_.bifurcations[pd.bifurcation].to_branch = branches_;
+          follow(std::move(pt), branches_, period, pd.period, pd.bifurcation);
+          return;
+        }
+      }
+    }
+    note(fmt::format("branch switching at the period doubling at {} = {:.10g}: no period-{} orbit "
+                     "found next to it",
+                     options_.parameter.name(), pd.at.p, period));
+  }
+
+  const analysis::PointModel& model_;
+  const ContinuationOptions& options_;
+  ContinuationObserver* observer_;
+  ContinuationResult& result_;
+  std::map<double, StroboscopicMap> maps_;
+  std::deque<Pending> pending_;
+  int branches_ = 0;
+  double initial_step_ = 0, min_step_ = 0, max_step_ = 0, lo_ = 0, hi_ = 0;
+};
+
+}  // namespace
+
+ContinuationResult continue_periodic_orbit(const analysis::PointModel& model, const Vector& guess,
+                                           const ContinuationOptions& options,
+                                           ContinuationObserver* observer) {
+  std::string why;
+  if (!options.is_valid(&why)) throw InputError(why);
+  if (!model.has(options.parameter, &why)) throw InputError(why);
+  if (!model.accepts(options.parameter, options.start, &why)) throw InputError(why);
+  ContinuationResult result;
+  Continuer continuer(model, options, observer, result);
+  continuer.run(guess);
+  return result;
+}
+
+}  // namespace pwl::orbits

@@ -1,0 +1,86 @@
+#include "pwl/orbits/stroboscopic_map.hpp"
+
+#include <cmath>
+#include <fmt/format.h>
+#include <limits>
+
+#include "pwl/errors.hpp"
+
+namespace pwl::orbits {
+
+StroboscopicMap::StroboscopicMap(const analysis::PointCase& point, const MethodSettings& settings,
+                                 int steps_per_period)
+    : point_(point), steps_per_period_(steps_per_period) {
+  if (!(std::isfinite(point.period) && point.period > 0)) {
+    throw InputError(fmt::format("forcing period = {} must be positive and finite", point.period));
+  }
+  if (method_traits(settings.method).fixed_grid && steps_per_period < 1) {
+    throw InputError(fmt::format("steps per period = {} must be >= 1", steps_per_period));
+  }
+  settings_ = settings.for_period(point.period, steps_per_period);
+  integrator_ = make_integrator(point_.structure, settings_);
+}
+
+StroboscopicMap::~StroboscopicMap() = default;
+StroboscopicMap::StroboscopicMap(StroboscopicMap&&) noexcept = default;
+StroboscopicMap& StroboscopicMap::operator=(StroboscopicMap&&) noexcept = default;
+
+bool StroboscopicMap::exact_tangent() const { return integrator_->has_tangent_map(); }
+
+Vector StroboscopicMap::integrate(const Vector& y, double t0, double t1, Matrix* tangent) {
+  const Index n = dofs();
+  if (y.size() != 2 * n) {
+    throw InputError(fmt::format("state has {} components, the structure needs {}", y.size(),
+                                 2 * n));
+  }
+  if (!y.allFinite()) throw InputError("state is not finite");
+  if (!(t1 > t0)) throw InputError(fmt::format("arc end {} must follow its start {}", t1, t0));
+  integrator_->set_state(t0, y.head(n), y.tail(n));
+  if (tangent != nullptr) {
+    integrator_->advance_with_tangent(t1, *tangent);
+  } else {
+    integrator_->advance_to(t1);
+  }
+  ++evaluations_;
+  Vector out(2 * n);
+  out << integrator_->position(), integrator_->velocity();
+  return out;
+}
+
+Vector StroboscopicMap::flow(const Vector& y, double t0, double t1, Matrix* tangent) {
+  if (tangent == nullptr) return integrate(y, t0, t1, nullptr);
+  if (tangent->rows() != state_size()) {
+    throw InputError(fmt::format("tangent has {} rows, the state {}", tangent->rows(),
+                                 state_size()));
+  }
+  if (exact_tangent()) return integrate(y, t0, t1, tangent);
+  // Forward differences, one integration per column.
+  const Vector base = integrate(y, t0, t1, nullptr);
+  const double root_eps = std::sqrt(std::numeric_limits<double>::epsilon());
+  for (Index c = 0; c < tangent->cols(); ++c) {
+    const double norm = tangent->col(c).norm();
+    if (norm == 0) continue;
+    const double eps = root_eps * (1 + y.norm()) / norm;
+    const Vector moved = integrate(y + eps * tangent->col(c), t0, t1, nullptr);
+    tangent->col(c) = (moved - base) / eps;
+  }
+  return base;
+}
+
+Vector StroboscopicMap::advance(const Vector& y, int periods, int start_period) {
+  if (periods < 1) throw InputError(fmt::format("periods = {} must be >= 1", periods));
+  return flow(y, start_period * forcing_period(), (start_period + periods) * forcing_period());
+}
+
+Vector StroboscopicMap::advance(const Vector& y, int periods, Matrix& tangent, int start_period) {
+  if (periods < 1) throw InputError(fmt::format("periods = {} must be >= 1", periods));
+  return flow(y, start_period * forcing_period(), (start_period + periods) * forcing_period(),
+              &tangent);
+}
+
+Vector StroboscopicMap::advance_with_jacobian(const Vector& y, int periods, Matrix& jacobian) {
+  jacobian = Matrix::Identity(state_size(), state_size());
+  return advance(y, periods, jacobian);
+}
+
+}  // namespace pwl::orbits
