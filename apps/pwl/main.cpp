@@ -25,6 +25,8 @@ int main(int argc, char** argv) {
   pwl::app::add_bench_command(app);
   pwl::app::add_sweep_command(app);
   pwl::app::add_map_command(app);
+  pwl::app::add_orbit_command(app);
+  pwl::app::add_continue_command(app);
   pwl::app::add_run_command(app);
   pwl::app::add_scene_options(app);
   // An empty list's default reads "[]" in --help: show nothing instead.

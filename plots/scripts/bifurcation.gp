@@ -3,7 +3,10 @@
 # colours, and below them a strip coloured by the regime of every point.
 # Variables (gnuplot -e): poincare (bifurcation_points.csv or poincare.csv of pwl sweep), classes
 # (classification.csv), out, fmt, column (the
-# column to draw, 5 = the first recorded component), xname, yname, title.
+# column to draw, 5 = the first recorded component), xname, yname, title; and, to draw the
+# periodic-orbit branches of pwl continue over the points (pwl sweep --branches), branches (its
+# branch_section.csv: parameter,branch,period,stable,iterate,components) and bcolumn (the column of
+# the drawn component there).
 if (!exists("poincare")) poincare = 'plots/data/theta_sweep/poincare.csv'
 if (!exists("classes")) classes = 'plots/data/theta_sweep/classification.csv'
 if (!exists("out")) out = 'plots/figures/bifurcation.png'
@@ -11,6 +14,13 @@ if (!exists("column")) column = 5
 if (!exists("xname")) xname = 'theta'
 if (!exists("yname")) yname = 'x5'
 if (!exists("title")) title = ''
+if (!exists("branches")) branches = ''
+if (!exists("bcolumn")) bcolumn = 6
+# The branches' points: stable ones filled and dark, unstable ones open and light (an empty
+# macro without branches, so that the plot is the same as before).
+overlay = branches eq '' ? '' : \
+  ", branches using 1:($4 == 1 ? column(bcolumn) : NaN) with points pt 7 ps 0.4 lc rgb '#111111' title 'orbit branch, stable', " . \
+  "branches using 1:($4 == 0 ? column(bcolumn) : NaN) with points pt 6 ps 0.4 lc rgb '#e377c2' title 'orbit branch, unstable'"
 set datafile separator ','
 call 'terminal.gp' 1400 900 12
 # Regime codes (sweep_point.hpp): 1..8 period-k, 9 longer period, 10 quasi-periodic, 11 chaotic,
@@ -38,7 +48,7 @@ plot poincare using 1:(strcol(2) eq 'up' ? column(column) : NaN) with points pt 
      poincare using 1:(strcol(2) eq 'down' ? column(column) : NaN) with points pt 7 ps 0.12 lc rgb '#d9531e' \
        notitle, \
      NaN with points pt 7 lc rgb '#1f3fbf' title 'upward (or independent)', \
-     NaN with points pt 7 lc rgb '#d9531e' title 'downward', \
+     NaN with points pt 7 lc rgb '#d9531e' title 'downward' @overlay, \
      NaN with points pt 0 lc rgb 'white' title ' ', \
      NaN with points pt 0 lc rgb 'white' title 'regime strip:', \
      NaN with points pt 5 lc rgb '#1f77b4' title 'period-1', \

@@ -322,8 +322,15 @@ class Continuer {
   static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
   void follow(Point first, int branch, int period, int parent_period, std::size_t source) {
     const std::string label = fmt::format("branch {} (period {})", branch, period);
-    const Vector first_y = first.y;
     const double first_p = first.p;
+    std::vector<Vector> first_orbit{first.y};
+    for (int j = 1; j < period; ++j) {
+      try {
+        first_orbit.push_back(map_at(first_p).advance(first_orbit.back(), 1));
+      } catch (const Error&) {
+        break;
+      }
+    }
     Point current = std::move(first);
     double arclength = 0;
     {
@@ -332,6 +339,7 @@ class Continuer {
     }
     double h = initial_step_;
     int points = 1;
+    Vector previous_secant;
     const double margin = 1e-9 * (hi_ - lo_);
     while (true) {
       if (points >= options_.max_points) {
@@ -359,7 +367,26 @@ class Continuer {
         h /= 2;
         continue;
       }
-      if (parent_period > 0 && rejoins(current, *next, h, parent_period, source, branch)) {
+      // A step that turns back on the previous one (the secants at more than 90°) has gone back
+      // along the branch, which happens at a sharp (non-smooth) turning point: shorter steps.
+      Vector secant(N + 1);
+      secant.head(N) = next->y - current.y;
+      secant(N) = next->p - current.p;
+      if (previous_secant.size() == secant.size() && secant.dot(previous_secant) < 0) {
+        if (h > 4 * min_step_) {
+          h /= 2;
+          continue;
+        }
+        note(fmt::format("{}: stopped at {} = {:.10g} after {} points: the branch turns back "
+                         "on itself there even at the smallest step",
+                         label, options_.parameter.name(), current.p, points));
+        return;
+      }
+      previous_secant = secant;
+      // (Its own period doubling counts once the branch has gone some way: a loop of period-2k
+      // orbits may come back to where it started, as the other half of the same orbits.)
+      if (parent_period > 0 &&
+          rejoins(current, *next, h, parent_period, points > 10 ? kNone : source, branch)) {
         note(fmt::format("{}: rejoined the period-{} branch at its period doubling near {} = "
                          "{:.10g} after {} points",
                          label, parent_period, options_.parameter.name(), next->p, points));
@@ -381,17 +408,28 @@ class Continuer {
         }
       }
       if (points > 10) {
-        Vector gap(N + 1);
-        gap.head(N) = next->y - first_y;
-        gap(N) = next->p - first_p;
-        if (gap.norm() < h) {
-          note(fmt::format("{}: closed on itself after {} points", label, points));
-          return;
+        // Closed: back at the first orbit, as the same state or as the same orbit started j
+        // periods later (a period-k orbit is k fixed points of the period-k map).
+        for (const Vector& start : first_orbit) {
+          Vector gap(N + 1);
+          gap.head(N) = next->y - start;
+          gap(N) = next->p - first_p;
+          if (gap.norm() < h) {
+            note(fmt::format("{}: closed on itself after {} points", label, points));
+            return;
+          }
         }
       }
       arclength += h;
       ++points;
+      retracing_ = false;
       detect(current, *next, h, branch, period);
+      if (retracing_) {
+        note(fmt::format("{}: stopped at {} = {:.10g} after {} points: it meets a bifurcation of "
+                         "its own again, so from here it retraces its orbits",
+                         label, options_.parameter.name(), next->p, points));
+        return;
+      }
       BranchPoint bp = branch_point(*next, branch, period, arclength);
       emit(bp);
       const int iterations = next->iterations;
@@ -401,7 +439,11 @@ class Continuer {
                          options_.parameter.name(), current.p, points));
         return;
       }
-      if (iterations <= 2) h = std::min(1.5 * h, max_step_);
+      // The largest arclength step: max_step_ in the parameter, up to 100 max_step_ in all.
+      const double parameter_share = std::abs(current.tangent(current.tangent.size() - 1));
+      const double largest = max_step_ * std::min(1.0 / std::max(parameter_share, 1e-12), 100.0);
+      if (iterations <= 2) h = std::min(1.5 * h, largest);
+      h = std::min(h, largest);
       if (iterations >= 5) h *= 0.6;
     }
   }
@@ -428,7 +470,7 @@ class Continuer {
       const double w = length2 > 0 ? std::clamp(ap.dot(ab) / length2, 0.0, 1.0) : 0.0;
       const double distance = (ap - w * ab).norm();
       if (distance <= std::max(0.25 * h, 1e-7)) {
-        if (bif.to_branch < 0) bif.to_branch = branch;
+        bif.joined_by = branch;
         std::erase_if(pending_, [&](const Pending& p) { return p.bifurcation == i; });
         return true;
       }
@@ -446,8 +488,18 @@ class Continuer {
   void detect(Point& a, Point& b, double h, int branch, int period) {
     const Signature sa = signature(a.mu), sb = signature(b.mu);
     std::vector<std::pair<BifurcationType, int>> found;  // type, spring (grazing) * 2 + which
-    if ((sa.real_above_one - sb.real_above_one) % 2 != 0) found.emplace_back(BifurcationType::fold, -1);
-    if ((sa.real_below_minus_one - sb.real_below_minus_one) % 2 != 0) {
+    // A real multiplier that stays within kNoise of ±1 at both points is not a transversal
+    // crossing but a multiplier pinned there (the +1 of a period-2k branch at the period doubling
+    // it starts from), wobbling by rounding.
+    constexpr double kNoise = 1e-6;
+    const auto clear = [&](double target) {
+      return std::max(std::abs(nearest_real(a.mu, target) - target),
+                      std::abs(nearest_real(b.mu, target) - target)) > kNoise;
+    };
+    if ((sa.real_above_one - sb.real_above_one) % 2 != 0 && clear(1.0)) {
+      found.emplace_back(BifurcationType::fold, -1);
+    }
+    if ((sa.real_below_minus_one - sb.real_below_minus_one) % 2 != 0 && clear(-1.0)) {
       found.emplace_back(BifurcationType::period_doubling, -1);
     }
     if (sa.complex_outside != sb.complex_outside &&
@@ -573,6 +625,18 @@ class Continuer {
     if (type == BifurcationType::grazing) {
       bif.spring = which / 2;
       bif.at_largest_gap = which % 2 == 0;
+    }
+    bif.located = located;
+    // A switched branch that meets a bifurcation of its own again retraces its orbits, each now
+    // started some periods later (a period-2k loop traversed as its two halves): stop it there.
+    if (branch > 0) {
+      for (const Bifurcation& other : result_.bifurcations) {
+        if (other.branch == branch && other.type == type && other.spring == bif.spring &&
+            std::abs(other.parameter - bif.parameter) <= 1e-6 * (hi_ - lo_)) {
+          retracing_ = true;
+          return;
+        }
+      }
     }
     if (!located) {
       note(fmt::format("{} near {} = {:.10g} on branch {}: detected, not located (bracket {:.10g} "
@@ -730,6 +794,7 @@ class Continuer {
   std::map<double, StroboscopicMap> maps_;
   std::deque<Pending> pending_;
   int branches_ = 0;
+  bool retracing_ = false;
   double initial_step_ = 0, min_step_ = 0, max_step_ = 0, lo_ = 0, hi_ = 0;
 };
 

@@ -143,6 +143,7 @@ FloquetMultipliers leading_floquet_multipliers(const std::function<void(Matrix&)
     }
     if (!start.allFinite() || start.norm() == 0) break;
   }
+  result.converged = result.residual <= options.tolerance;
   sort_multipliers(result.values);
   return result;
 }

@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "orbits/gmres.hpp"
+#include "orbits/open_structure_preconditioner.hpp"
 
 namespace pwl::orbits {
 
@@ -235,23 +236,50 @@ PeriodicOrbit find_periodic_orbit(StroboscopicMap& map, const Vector& guess,
   }
 
   // Matrix-free Newton-Krylov, single shooting.
+  std::optional<detail::OpenStructurePreconditioner> preconditioner;
+  if (options.precondition) {
+    preconditioner.emplace(map.structure(), options.period * map.forcing_period());
+  }
+  double forcing = 1e-2, previous_residual = 0;
+  long krylov_products = 0;
   Vector y = guess;
   Vector F = map.advance(y, options.period) - y;
   double residual = inf_norm(F);
+  const auto krylov_answer = [&](int iteration) {
+    PeriodicOrbit orbit =
+        finish(map, options, y, residual, iteration, false, Matrix(), evaluations_before);
+    orbit.krylov_products = krylov_products;
+    orbit.preconditioned = preconditioner && preconditioner->available();
+    return orbit;
+  };
   for (int iteration = 0;; ++iteration) {
     if (!F.allFinite()) throw fail("met a non-finite state", residual, iteration);
-    if (converged(residual, y)) {
-      return finish(map, options, y, residual, iteration, false, Matrix(), evaluations_before);
-    }
+    if (converged(residual, y)) return krylov_answer(iteration);
     if (iteration == options.max_iterations) throw fail("did not converge", residual, iteration);
-    const auto apply = [&](const Vector& v) -> Vector {
-      Matrix t = v;
-      map.advance(y, options.period, t);
-      return t.col(0) - v;
+    // Right-preconditioned GMRES on (M − I) P u = −F, δ = P u.
+    const auto precondition = [&](const Vector& v) -> Vector {
+      return preconditioner && preconditioner->available() ? preconditioner->apply(v) : v;
     };
-    const double forcing = std::clamp(F.norm() / std::max(1.0, y.norm()), 1e-12, 1e-2);
-    Vector delta;
-    detail::gmres(apply, -F, delta, forcing, options.gmres_dimension, options.gmres_restarts);
+    const auto apply = [&](const Vector& v) -> Vector {
+      const Vector pv = precondition(v);
+      Matrix t = pv;
+      map.advance(y, options.period, t);
+      return t.col(0) - pv;
+    };
+    // Eisenstat-Walker forcing (their choice 2, with its safeguard), never below what the
+    // tolerance needs.
+    if (iteration > 0) {
+      double next = 0.9 * std::pow(residual / previous_residual, 2);
+      if (0.9 * forcing * forcing > 1e-2) next = std::max(next, 0.9 * forcing * forcing);
+      forcing = std::min(next, 1e-2);
+    }
+    forcing = std::max(forcing, 0.5 * options.tolerance * std::max(1.0, inf_norm(y)) / residual);
+    Vector u;
+    const detail::GmresResult g =
+        detail::gmres(apply, -F, u, forcing, options.gmres_dimension, options.gmres_restarts);
+    krylov_products += g.products;
+    const Vector delta = precondition(u);
+    previous_residual = residual;
     if (!delta.allFinite()) throw fail("met a singular Jacobian (a multiplier at 1)", residual, iteration);
     bool accepted = false;
     for (double lambda = 1.0; lambda >= 1.0 / 64; lambda /= 2) {
@@ -259,7 +287,8 @@ PeriodicOrbit find_periodic_orbit(StroboscopicMap& map, const Vector& guess,
       try {
         Vector trial_F = map.advance(trial, options.period) - trial;
         const double trial_residual = inf_norm(trial_F);
-        if (trial_F.allFinite() && trial_residual < (1 - 1e-4 * lambda) * residual) {
+        // Sufficient decrease of |F|_2, which GMRES minimises.
+        if (trial_F.allFinite() && trial_F.norm() < (1 - 1e-4 * lambda) * F.norm()) {
           y = trial;
           F = std::move(trial_F);
           residual = trial_residual;
@@ -270,9 +299,7 @@ PeriodicOrbit find_periodic_orbit(StroboscopicMap& map, const Vector& guess,
       }
     }
     if (!accepted) {
-      if (residual <= 1e-13 * std::max(1.0, inf_norm(y))) {
-        return finish(map, options, y, residual, iteration, false, Matrix(), evaluations_before);
-      }
+      if (residual <= 1e-13 * std::max(1.0, inf_norm(y))) return krylov_answer(iteration);
       throw fail("stalled (no damped step decreases the residual)", residual, iteration);
     }
   }

@@ -5,12 +5,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <memory>
 #include <set>
 
 #include "commands/commands.hpp"
+#include "commands/sweep_command.hpp"
 #include "output/gnuplot.hpp"
 #include "pwl/study/parameter_sweep.hpp"
 #include "pwl/errors.hpp"
@@ -28,6 +30,7 @@ struct SweepFlags {
   int points = 100;
   std::string mode = "independent";
   std::string directions = "both";
+  std::string branches;  // a pwl continue folder whose branch_section.csv the figure draws
 };
 
 analysis::SweepOptions sweep_options(const SweepFlags& f) {
@@ -85,37 +88,77 @@ void write_plotted_points(const analysis::SweepOptions& o,
   if (std::fclose(file) != 0) throw Error(fmt::format("cannot finish writing {}", path));
 }
 
-void sweep(const SweepFlags& f) {
-  const analysis::SweepOptions o = sweep_options(f);
-  Study study = study_of(o);
-  study.finish = [&](const std::map<long, analysis::PointResult>& records) {
-    analysis::write_sweep_files(o, records, f.run.out);
-    fmt::print("wrote {0}/poincare.csv and {0}/classification.csv ({1} points)\n", f.run.out,
-               records.size());
-    if (f.run.no_plot) return;
-    write_plotted_points(o, records, f.run.out + "/bifurcation_points.csv");
-    const auto definitions = [&](const std::string& format) {
-      return fmt::format(
-          "poincare='{0}/bifurcation_points.csv'; classes='{0}/classification.csv'; "
-          "out='{0}/bifurcation.{4}'; column=5; xname='{1}'; "
-          "yname='{2} at t = kT (nondimensional)'; title={3}",
-          f.run.out, parameter_label(o.parameter),
-          o.point.components.empty()
-              ? std::string("x")
-              : analysis::component_name(o.point.components[0], o.model().dofs()),
-          gnuplot_quoted(fmt::format(
-              "pwl sweep of {} ({}): {}", analysis::parameter_name(o.parameter),
-              o.mode == analysis::SweepMode::continuation ? "continuation" : "independent",
-              study_title(o.model(), o.point))),
-          format);
-    };
-    draw_figure_and_report(scripts_directory() + "/bifurcation.gp", definitions,
-                           f.run.out + "/bifurcation", "pwl sweep", false);
-  };
-  run_study(study, f.run);
+// The 1-based column of `component` in <branches>/branch_section.csv (pwl continue), for the
+// figure; InputError naming --branches when there is none.
+int branch_section_column(const std::string& branches, const std::string& component) {
+  const std::string path = branches + "/branch_section.csv";
+  std::ifstream in(path);
+  std::string header;
+  if (!in || !std::getline(in, header)) {
+    throw InputError(fmt::format(
+        "--branches {}: no {} (the folder of a pwl continue run of the same parameter)", branches,
+        path));
+  }
+  if (!header.empty() && header.back() == '\r') header.pop_back();
+  int column = 1;
+  for (std::size_t from = 0;; ++column) {
+    const std::size_t comma = header.find(',', from);
+    if (header.substr(from, comma == std::string::npos ? std::string::npos : comma - from) ==
+        component) {
+      return column;
+    }
+    if (comma == std::string::npos) break;
+    from = comma + 1;
+  }
+  throw InputError(fmt::format(
+      "--branches {}: {} has no column {} (the sweep's first recorded component); its columns: "
+      "{} (record that mass in pwl continue --record)",
+      branches, path, component, header));
 }
 
+void sweep(const SweepFlags& f) { run_sweep(sweep_options(f), f.run, f.branches); }
+
 }  // namespace
+
+void run_sweep(const analysis::SweepOptions& o, const RunFlags& run, const std::string& branches) {
+  const std::string component =
+      o.point.components.empty()
+          ? std::string("x")
+          : analysis::component_name(o.point.components[0], o.model().dofs());
+  // Checked before the sweep runs, so that a wrong folder costs nothing.
+  const int branch_column = branches.empty() || run.no_plot
+                                ? 0
+                                : branch_section_column(branches, component);
+  Study study = study_of(o);
+  study.finish = [&](const std::map<long, analysis::PointResult>& records) {
+    analysis::write_sweep_files(o, records, run.out);
+    fmt::print("wrote {0}/poincare.csv and {0}/classification.csv ({1} points)\n", run.out,
+               records.size());
+    if (run.no_plot) return;
+    write_plotted_points(o, records, run.out + "/bifurcation_points.csv");
+    const auto definitions = [&](const std::string& format) {
+      std::string overlay;
+      if (branch_column > 0) {
+        overlay = fmt::format("branches={}; bcolumn={}; ",
+                              gnuplot_quoted(branches + "/branch_section.csv"), branch_column);
+      }
+      return overlay +
+             fmt::format(
+                 "poincare='{0}/bifurcation_points.csv'; classes='{0}/classification.csv'; "
+                 "out='{0}/bifurcation.{4}'; column=5; xname='{1}'; "
+                 "yname='{2} at t = kT (nondimensional)'; title={3}",
+                 run.out, parameter_label(o.parameter), component,
+                 gnuplot_quoted(fmt::format(
+                     "pwl sweep of {} ({}): {}", analysis::parameter_name(o.parameter),
+                     o.mode == analysis::SweepMode::continuation ? "continuation" : "independent",
+                     study_title(o.model(), o.point))),
+                 format);
+    };
+    draw_figure_and_report(scripts_directory() + "/bifurcation.gp", definitions,
+                           run.out + "/bifurcation", "pwl sweep", false);
+  };
+  run_study(study, run);
+}
 
 void add_sweep_command(CLI::App& app) {
   auto flags = std::make_shared<SweepFlags>();
@@ -141,6 +184,10 @@ void add_sweep_command(CLI::App& app) {
       ->check(CLI::IsMember({"both", "up", "down"}));
   add_point_flags(*c, flags->point, true);
   add_run_flags(*c, flags->run);
+  c->add_option("--branches", flags->branches,
+                "Also draw the periodic-orbit branches of a pwl continue folder (its\n"
+                "branch_section.csv: stable filled, unstable open) over the diagram's points")
+      ->check(CLI::ExistingDirectory);
   c->callback([flags] { sweep(*flags); });
 }
 

@@ -134,7 +134,7 @@ void collect(const toml::table& doc, const std::string& name, bool is_override, 
       const auto* job = node.as_string();
       if (job == nullptr) {
         throw InputError(
-            fmt::format("{}: job: expected text (simulate, analyze, sweep, map or bench chain|scaling|accuracy|stability|sweep), got {}", at,
+            fmt::format("{}: job: expected text (simulate, analyze, sweep, map, orbit, continue or bench chain|scaling|accuracy|stability|sweep), got {}", at,
                         type_name(node)));
       }
       scene->job = job->get();
@@ -327,8 +327,9 @@ std::string screen_scene_text(std::string_view text, const std::string& name) {
 }
 
 const std::vector<std::string>& scene_sections() {
-  static const std::vector<std::string> sections{"structure", "method", "run",   "analysis",
-                                                 "sweep",     "map",    "bench",  "output"};
+  static const std::vector<std::string> sections{
+      "structure", "method", "run",   "analysis",     "sweep",
+      "map",       "orbit",  "bench", "continuation", "output"};
   return sections;
 }
 

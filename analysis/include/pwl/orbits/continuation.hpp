@@ -74,6 +74,11 @@ struct Bifurcation {
   bool at_largest_gap = true;
   double test_value = 0.0;    // the test function where located (≈ 0)
   int to_branch = -1;         // period doubling with branch switching: the branch it started
+  int joined_by = -1;         // period doubling: a switched branch that ended here (it rejoined
+                              // this branch at this point)
+  // Whether it was located (the test function brought to zero on the branch); false: only
+  // detected between two points of the branch, and `parameter` is the nearer of the two.
+  bool located = true;
 };
 
 struct ContinuationOptions {
@@ -82,7 +87,10 @@ struct ContinuationOptions {
   double end = 1.0;                    // ... and is followed toward here
   double initial_step = 0.0;  // arclength of the first step; 0: |end − start| / 100
   double min_step = 0.0;      // 0: 1e-7 |end − start|
-  double max_step = 0.0;      // 0: |end − start| / 25
+  // The largest step, as a change of the parameter: the arclength step is at most this divided by
+  // the parameter's share of the tangent (up to 100 times this), so that a branch whose state
+  // moves fast (near a resonance) is not crawled along. 0: |end − start| / 25.
+  double max_step = 0.0;
   int max_points = 2000;      // per branch
   int max_corrections = 7;    // Newton iterations of one corrector
   double locate_tolerance = 1e-10;  // of the bifurcation parameters

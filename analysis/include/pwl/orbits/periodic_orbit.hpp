@@ -13,7 +13,11 @@
 // integration of k periods with one tangent vector each; Y. Saad and M. H. Schultz, SIAM J. Sci.
 // Stat. Comput. 7 (1986) 856-869), to a relative residual that tightens as F shrinks (inexact
 // Newton, S. C. Eisenstat and H. F. Walker, SIAM J. Sci. Comput. 17 (1996) 16-32), and the leading
-// multipliers come from Arnoldi (floquet_multipliers.hpp).
+// multipliers come from Arnoldi (floquet_multipliers.hpp). A lightly damped chain's slow modes put
+// many eigenvalues of M − I near 0, where GMRES alone needs about one product per mode; GMRES is
+// therefore right-preconditioned by the inverse of M0 − I of the structure with its springs open
+// (modal 2 x 2 blocks when the damping is classical: analysis/src/orbits/
+// open_structure_preconditioner.hpp), which clusters the spectrum near 1.
 //
 // Multiple shooting. An orbit that is strongly unstable (|μ| ≫ 1) makes the single-shooting
 // Jacobian badly conditioned and its Newton basin tiny. With `shots` = m > 1 the k periods are cut
@@ -51,6 +55,9 @@ struct ShootingOptions {
   // Krylov: basis size of GMRES per Newton step and restarts.
   int gmres_dimension = 60;
   int gmres_restarts = 4;
+  // Krylov: precondition by the inverse of the open structure's M0 − I when its damping is
+  // classical (see the Krylov paragraph above); otherwise unpreconditioned.
+  bool precondition = true;
   // Floquet multipliers: all for the dense form; the leading `floquet_count` for Krylov.
   bool multipliers = true;
   ArnoldiOptions arnoldi;
@@ -70,6 +77,8 @@ struct PeriodicOrbit {
   long evaluations = 0;          // integrations of the map (k periods each, tangent included)
   bool exact_tangent = true;     // multipliers from the exact tangent (else forward differences)
   ShootingSolver solver = ShootingSolver::dense;  // the one used
+  long krylov_products = 0;      // Krylov: products with M − I in GMRES, over all iterations
+  bool preconditioned = false;   // Krylov: by the open structure (classical damping)
   FloquetMultipliers multipliers;
   Matrix monodromy;              // M at the answer (dense form only; empty otherwise)
 

@@ -1,0 +1,586 @@
+// pwl continue: a periodic orbit followed in one parameter by pseudo-arclength continuation, its
+// stability along the way and its bifurcations located (fold, period doubling, Neimark–Sacker,
+// grazing), optionally onto the period-doubled branches (analysis/include/pwl/orbits/
+// continuation.hpp). Writes as the branch grows, so that an interrupted run keeps its points; draws
+// the frequency response, and with --over-sweep the brute-force bifurcation diagram of the same
+// range with the branches over it.
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <memory>
+
+#include "commands/cli_checks.hpp"
+#include "commands/commands.hpp"
+#include "commands/orbit_options.hpp"
+#include "commands/study_runner.hpp"
+#include "commands/sweep_command.hpp"
+#include "output/gnuplot.hpp"
+#include "pwl/errors.hpp"
+#include "pwl/orbits/continuation.hpp"
+#include "pwl/orbits/orbit_profile.hpp"
+#include "pwl/study/parameter_sweep.hpp"
+
+namespace pwl::app {
+namespace {
+
+constexpr int kAllDofsUpTo = 10;  // --record's default: every mass up to this many, else the last
+
+struct ContinueFlags {
+  OrbitFlags orbit;
+  std::string parameter;
+  std::string range;
+  bool switch_branches = false;
+  int max_branches = 4;
+  int max_points = 2000;
+  double step = 0.0;
+  double min_step = 0.0;
+  double max_step = 0.0;
+  std::vector<std::string> record;
+  bool no_grazing = false;
+  int over_sweep = 0;
+  int over_periods = 100;
+  bool no_plot = false;
+  int threads = 0;
+};
+
+// The masses --record names (1-based "5" or "x5"), 0-based; the default when empty.
+std::vector<int> recorded_dofs(const std::vector<std::string>& record, int n) {
+  std::vector<int> dofs;
+  for (const std::string& name : record) {
+    const char* digits = name.c_str() + (name.size() > 1 && name[0] == 'x' ? 1 : 0);
+    char* end = nullptr;
+    const long i = std::strtol(digits, &end, 10);
+    if (*digits == '\0' || *end != '\0' || i < 1 || i > n) {
+      throw InputError(fmt::format("--record {}: name a mass 1..{} (or x1..x{})", name, n, n));
+    }
+    if (std::find(dofs.begin(), dofs.end(), static_cast<int>(i - 1)) == dofs.end()) {
+      dofs.push_back(static_cast<int>(i - 1));
+    }
+  }
+  if (record.empty()) {
+    if (n <= kAllDofsUpTo) {
+      for (int i = 0; i < n; ++i) dofs.push_back(i);
+    } else {
+      dofs.push_back(n - 1);
+    }
+  }
+  return dofs;
+}
+
+// A CSV file written a row at a time and flushed after each, so that a run that is interrupted
+// keeps every row it computed.
+class FlushedCsv {
+ public:
+  FlushedCsv(const std::string& path, const std::vector<std::string>& columns)
+      : file_(std::fopen(path.c_str(), "w")), path_(path) {
+    if (file_ == nullptr) throw Error(fmt::format("cannot write {}", path));
+    fmt::print(file_, "{}\n", fmt::join(columns, ","));
+    std::fflush(file_);
+  }
+  ~FlushedCsv() {
+    if (file_ != nullptr) std::fclose(file_);
+  }
+  FlushedCsv(const FlushedCsv&) = delete;
+  FlushedCsv& operator=(const FlushedCsv&) = delete;
+  void row(const std::string& text) {
+    fmt::print(file_, "{}\n", text);
+    if (std::fflush(file_) != 0) throw Error(fmt::format("cannot write {}", path_));
+  }
+
+ private:
+  std::FILE* file_;
+  std::string path_;
+};
+
+std::string number(double value) { return fmt::format("{:.17g}", value); }
+
+// Appends ",field" to a CSV row.
+void add_field(std::string& row, const std::string& field) {
+  row += ',';
+  row += field;
+}
+
+// The detail column of bifurcations.csv.
+std::string detail_of(const orbits::Bifurcation& b) {
+  std::vector<std::string> parts;
+  if (b.type == orbits::BifurcationType::grazing) {
+    parts.emplace_back(b.at_largest_gap ? "largest gap" : "smallest gap");
+  }
+  if (b.to_branch >= 0) parts.push_back(fmt::format("starts branch {}", b.to_branch));
+  if (b.joined_by >= 0) parts.push_back(fmt::format("ends branch {}", b.joined_by));
+  if (!b.located) parts.emplace_back("not located (detected between two branch points)");
+  return fmt::format("{}", fmt::join(parts, "; "));
+}
+
+// What the continuation writes as it goes, and its progress on standard error.
+class ContinueOutputs : public orbits::ContinuationObserver {
+ public:
+  ContinueOutputs(const std::string& folder, const analysis::PointModel& model,
+                  const analysis::SweepParameter& parameter, const OrbitMethod& method,
+                  std::vector<int> dofs, bool progress)
+      : model_(model),
+        parameter_(parameter),
+        method_(method),
+        dofs_(std::move(dofs)),
+        n_(model.dofs()),
+        branch_(folder + "/branch.csv", branch_columns()),
+        section_(folder + "/branch_section.csv", section_columns()),
+        bifurcations_(folder + "/bifurcations.csv", bifurcation_columns()),
+        progress_(progress),
+        tty_(::isatty(STDERR_FILENO) != 0),
+        start_(std::chrono::steady_clock::now()),
+        last_(start_) {}
+
+  std::vector<std::string> branch_columns() const {
+    std::vector<std::string> c{"branch", "parameter", "period", "stable", "max_abs_multiplier"};
+    for (int i : dofs_) c.push_back(fmt::format("amplitude_x{}", i + 1));
+    for (int i : dofs_) c.push_back(fmt::format("x{}", i + 1));
+    c.push_back("unstable_multipliers");
+    return c;
+  }
+  std::vector<std::string> section_columns() const {
+    std::vector<std::string> c{"parameter", "branch", "period", "stable", "iterate"};
+    for (int i : dofs_) c.push_back(fmt::format("x{}", i + 1));
+    for (int i : dofs_) c.push_back(fmt::format("v{}", i + 1));
+    return c;
+  }
+  static std::vector<std::string> bifurcation_header() {
+    return {"type",          "parameter",     "branch",         "period", "spring",
+            "multiplier_re", "multiplier_im", "abs_multiplier", "detail"};
+  }
+  std::vector<std::string> bifurcation_columns() const {
+    std::vector<std::string> c = bifurcation_header();
+    for (int i : dofs_) c.push_back(fmt::format("amplitude_x{}", i + 1));
+    return c;
+  }
+
+  void point(const orbits::BranchPoint& p) override {
+    const orbits::PeriodicOrbit& orbit = p.orbit;
+    const bool stable = orbit.stable();
+    std::string row = fmt::format("{},{},{},{},{}", p.branch, number(p.parameter), orbit.period,
+                                  stable ? 1 : 0, number(orbit.multipliers.largest_modulus()));
+    for (int i : dofs_) add_field(row, number(p.profile.amplitude(i)));
+    for (int i : dofs_) add_field(row, number(orbit.state(i)));
+    row += fmt::format(",{}", orbit.multipliers.unstable_count());
+    branch_.row(row);
+    // The k Poincaré points of a period-k orbit: its state and k - 1 returns of the map.
+    Vector y = orbit.state;
+    std::unique_ptr<orbits::StroboscopicMap> map;
+    for (int j = 0; j < orbit.period; ++j) {
+      if (j > 0) {
+        if (!map) map = map_at(p.parameter);
+        y = map->advance(y, 1, j - 1);
+      }
+      std::string s = fmt::format("{},{},{},{},{}", number(p.parameter), p.branch, orbit.period,
+                                  stable ? 1 : 0, j);
+      for (int i : dofs_) add_field(s, number(y(i)));
+      for (int i : dofs_) add_field(s, number(y(n_ + i)));
+      section_.row(s);
+    }
+    ++points_;
+    ++per_branch_[p.branch];
+    if (stable) ++stable_[p.branch];
+    const auto [at, first] = range_.try_emplace(p.branch, p.parameter, p.parameter);
+    if (!first) {
+      at->second.first = std::min(at->second.first, p.parameter);
+      at->second.second = std::max(at->second.second, p.parameter);
+    }
+    period_[p.branch] = orbit.period;
+    if (points_ == 1) {
+      first_residual_ = orbit.residual;
+      first_iterations_ = orbit.iterations;
+    }
+    show(p);
+  }
+
+  void bifurcation(const orbits::Bifurcation& b) override {
+    bifurcations_.row(bifurcation_row(b));
+  }
+
+  // bifurcations.csv again from the final list (a period doubling learns which branch it started
+  // only once the switch is made).
+  void rewrite_bifurcations(const std::string& folder,
+                            const std::vector<orbits::Bifurcation>& all) {
+    FlushedCsv csv(folder + "/bifurcations.csv", bifurcation_columns());
+    for (const orbits::Bifurcation& b : all) csv.row(bifurcation_row(b));
+  }
+
+  void finish_progress() {
+    if (progress_ && tty_ && drawn_) std::fputc('\n', stderr);
+  }
+
+  long points() const { return points_; }
+  const std::map<int, long>& per_branch() const { return per_branch_; }
+  const std::map<int, long>& stable() const { return stable_; }
+  const std::map<int, std::pair<double, double>>& range() const { return range_; }
+  const std::map<int, int>& period() const { return period_; }
+  double first_residual() const { return first_residual_; }
+  int first_iterations() const { return first_iterations_; }
+
+ private:
+  std::unique_ptr<orbits::StroboscopicMap> map_at(double p) const {
+    return std::make_unique<orbits::StroboscopicMap>(model_.with(parameter_, p).point_case(),
+                                                     method_.settings, method_.steps_per_period);
+  }
+
+  std::string bifurcation_row(const orbits::Bifurcation& b) {
+    const bool grazing = b.type == orbits::BifurcationType::grazing;
+    std::string row = fmt::format("{},{},{},{},{}", orbits::bifurcation_name(b.type),
+                                  number(b.parameter), b.branch, b.period,
+                                  grazing ? fmt::format("{}", b.spring + 1) : std::string());
+    if (grazing) {
+      row += ",,,";
+    } else {
+      row += fmt::format(",{},{},{}", number(b.multiplier.real()), number(b.multiplier.imag()),
+                         number(std::abs(b.multiplier)));
+    }
+    add_field(row, detail_of(b));
+    // The amplitudes of the orbit there, for the figure's marks.
+    const auto cached = amplitudes_.find(b.parameter);
+    if (cached == amplitudes_.end()) {
+      Vector amplitude = Vector::Constant(n_, std::numeric_limits<double>::quiet_NaN());
+      try {
+        auto map = map_at(b.parameter);
+        amplitude = orbits::orbit_profile(*map, b.state, b.period).amplitude;
+      } catch (const Error&) {
+        // left empty: the mark is not drawn
+      }
+      amplitudes_.emplace(b.parameter, amplitude);
+    }
+    const Vector& amplitude = amplitudes_.at(b.parameter);
+    for (int i : dofs_) {
+      add_field(row, std::isfinite(amplitude(i)) ? number(amplitude(i)) : std::string());
+    }
+    return row;
+  }
+
+  void show(const orbits::BranchPoint& p) {
+    if (!progress_) return;
+    const auto now = std::chrono::steady_clock::now();
+    // A terminal gets one line redrawn ten times a second; a log a line every five seconds.
+    if (now - last_ < std::chrono::milliseconds(tty_ ? 100 : 5000) && points_ > 1) return;
+    last_ = now;
+    const double seconds = std::chrono::duration<double>(now - start_).count();
+    const std::string text =
+        fmt::format("continue: {} points, branch {} (period {}), {} = {:.6g}, {:.1f} s",
+                    points_, p.branch, p.orbit.period, parameter_.name(), p.parameter, seconds);
+    if (tty_) {
+      fmt::print(stderr, "\r{:<78}", text);
+      drawn_ = true;
+    } else {
+      fmt::print(stderr, "{}\n", text);
+    }
+    std::fflush(stderr);
+  }
+
+  const analysis::PointModel& model_;
+  analysis::SweepParameter parameter_;
+  OrbitMethod method_;
+  std::vector<int> dofs_;
+  Index n_;
+  FlushedCsv branch_;
+  FlushedCsv section_;
+  FlushedCsv bifurcations_;
+  bool progress_;
+  bool tty_;
+  bool drawn_ = false;
+  std::chrono::steady_clock::time_point start_, last_;
+  long points_ = 0;
+  std::map<int, long> per_branch_, stable_;
+  std::map<int, std::pair<double, double>> range_;
+  std::map<int, int> period_;
+  std::map<double, Vector> amplitudes_;
+  double first_residual_ = 0.0;
+  int first_iterations_ = 0;
+};
+
+void print_bifurcations(const std::vector<orbits::Bifurcation>& all, const std::string& name) {
+  if (all.empty()) {
+    fmt::print("bifurcations: none found\n");
+    return;
+  }
+  fmt::print("bifurcations ({}):\n", all.size());
+  fmt::print("  {:<16} {:>14} {:>6} {:>6} {:>6}  {:<26} {:>10}  {}\n", "type", name, "branch",
+             "period", "spring", "multiplier", "|μ|", "detail");
+  for (const orbits::Bifurcation& b : all) {
+    const bool grazing = b.type == orbits::BifurcationType::grazing;
+    fmt::print("  {:<16} {:>14.10g} {:>6} {:>6} {:>6}  {:<26} {:>10}  {}\n",
+               orbits::bifurcation_name(b.type), b.parameter, b.branch, b.period,
+               grazing ? fmt::format("{}", b.spring + 1) : std::string("-"),
+               grazing ? std::string("-") : multiplier_text(b.multiplier),
+               grazing ? std::string("-") : fmt::format("{:.6f}", std::abs(b.multiplier)),
+               detail_of(b));
+  }
+}
+
+void draw_frequency_response(const ContinueFlags& f, const ContinueOutputs& outputs,
+                             const std::vector<orbits::Bifurcation>& found,
+                             const std::vector<int>& dofs, const analysis::SweepParameter& parameter,
+                             bool chain, const std::string& title) {
+  const std::string& out = f.orbit.out;
+  const int plotted = static_cast<int>(dofs.size());  // the last recorded mass's amplitude
+  std::string periods;
+  int last_branch = 0;
+  for (const auto& [branch, period] : outputs.period()) {
+    periods += fmt::format("bp{} = {}; ", branch, period);
+    last_branch = std::max(last_branch, branch);
+  }
+  // How many of each kind, so that the legend names only the kinds found.
+  std::map<orbits::BifurcationType, int> kinds;
+  for (const orbits::Bifurcation& b : found) ++kinds[b.type];
+  const std::string counts = fmt::format(
+      "nfold = {}; ndoubling = {}; nns = {}; ngrazing = {}; ", kinds[orbits::BifurcationType::fold],
+      kinds[orbits::BifurcationType::period_doubling],
+      kinds[orbits::BifurcationType::neimark_sacker], kinds[orbits::BifurcationType::grazing]);
+  const auto definitions = [&](const std::string& format) {
+    return fmt::format(
+        "branch='{0}/branch.csv'; bifurcations='{0}/bifurcations.csv'; out='{0}/"
+        "frequency_response.{1}'; ycolumn={2}; bcolumn={3}; branches={4}; {5}xname={6}; "
+        "yname={7}; title={8}",
+        out, format, 5 + plotted, 9 + plotted, last_branch + 1, periods + counts,
+        gnuplot_quoted(parameter_label(parameter)),
+        gnuplot_quoted(fmt::format("amplitude max |x_{}(t)| over the orbit{}", dofs.back() + 1,
+                                   chain ? " (nondimensional)" : "")),
+        gnuplot_quoted(title));
+  };
+  draw_figure_and_report(scripts_directory() + "/frequency_response.gp", definitions,
+                         out + "/frequency_response", "pwl continue", false);
+}
+
+void run_over_sweep(const ContinueFlags& f, const analysis::PointModel& model,
+                    const analysis::SweepParameter& parameter, const OrbitMethod& method,
+                    double from, double to, const std::vector<int>& dofs,
+                    const std::string& title) {
+  const int dof = dofs.back();  // the figures draw the last recorded mass
+  analysis::SweepOptions o;
+  if (model.explicit_structure()) {
+    o.structure = model.structure();
+  } else {
+    o.chain = model.chain();
+  }
+  o.parameter = parameter;
+  o.from = std::min(from, to);
+  o.to = std::max(from, to);
+  o.points = f.over_sweep;
+  o.mode = analysis::SweepMode::continuation;
+  const int n = model.dofs();
+  o.point.transient_periods = f.orbit.transient;
+  o.point.recorded_periods = f.over_periods;
+  o.point.steps_per_period = method.steps_per_period;
+  o.point.lyapunov = false;
+  o.point.method = method.settings;
+  o.point.lyapunov_estimate = analysis::default_lyapunov_estimate(method.settings.method);
+  o.point.components = {dof, n + dof};
+  std::string why;
+  if (!o.is_valid(&why)) throw InputError(fmt::format("--over-sweep {}: {}", f.over_sweep, why));
+  RunFlags run;
+  run.out = f.orbit.out + "/over_sweep";
+  run.quiet = f.orbit.quiet;
+  run.no_plot = f.no_plot;
+  run.threads = f.threads;
+  fmt::print("over-sweep: {} values of {} by continuation up and down, {} + {} periods each, "
+             "into {}\n",
+             f.over_sweep, parameter.name(), o.point.transient_periods, o.point.recorded_periods,
+             run.out);
+  run_sweep(o, run, f.orbit.out);
+  if (f.no_plot) return;
+  const auto definitions = [&](const std::string& format) {
+    return fmt::format(
+        "poincare='{0}/bifurcation_points.csv'; section='{1}/branch_section.csv'; column=5; "
+        "scolumn={2}; out='{1}/branch_over_diagram.{3}'; xname={4}; yname={5}; title={6}",
+        run.out, f.orbit.out, 5 + static_cast<int>(dofs.size()), format, gnuplot_quoted(parameter_label(parameter)),
+        gnuplot_quoted(fmt::format("x_{} at t = kT{}", dof + 1,
+                                   model.explicit_structure() ? "" : " (nondimensional)")),
+        gnuplot_quoted(title));
+  };
+  draw_figure_and_report(scripts_directory() + "/branch_over_diagram.gp", definitions,
+                         f.orbit.out + "/branch_over_diagram", "pwl continue", false);
+}
+
+void continue_orbit(const ContinueFlags& f) {
+  const auto start = std::chrono::steady_clock::now();
+  const OrbitFlags& o = f.orbit;
+  check_orbit_flags(o);
+  const analysis::PointModel base = point_model(o.run);
+  if (f.parameter.empty()) throw InputError("--parameter: name the parameter to follow");
+  const analysis::SweepParameter parameter = parse_model_parameter(base, "--parameter", f.parameter);
+  if (f.range.empty()) throw InputError("--range: give the range as FROM:TO");
+  double from = 0, to = 0;
+  parse_range("--range", f.range, &from, &to);
+  if (!std::isfinite(from) || !std::isfinite(to) || from == to) {
+    throw InputError(fmt::format("--range = \"{}\": the two ends must be different finite values",
+                                 f.range));
+  }
+  std::string why;
+  for (const double end : {from, to}) {
+    if (!base.accepts(parameter, end, &why)) {
+      throw InputError(fmt::format("--range = \"{}\": at {} = {}: {}", f.range, parameter.name(),
+                                   end, why));
+    }
+  }
+  if (f.max_points < 2) throw InputError(fmt::format("--max-points = {} must be >= 2", f.max_points));
+  if (f.over_sweep == 1) {
+    throw InputError("--over-sweep = 1: a bifurcation diagram needs at least 2 values");
+  }
+  const int n = base.dofs();
+  const std::vector<int> dofs = recorded_dofs(f.record, n);
+
+  const analysis::PointModel at_start = base.with(parameter, from);
+  const analysis::PointCase first_case = at_start.point_case();
+  const OrbitMethod method = orbit_method(o, first_case.structure, first_case.period);
+  if (!method_traits(method.settings.method).fixed_grid && o.run.dt != 0.0) {
+    throw InputError("--dt: the continuation's step is --steps-per-period (the period varies)");
+  }
+  orbits::ContinuationOptions c;
+  c.parameter = parameter;
+  c.start = from;
+  c.end = to;
+  c.initial_step = f.step;
+  c.min_step = f.min_step;
+  c.max_step = f.max_step;
+  c.max_points = f.max_points;
+  c.grazing = !f.no_grazing;
+  c.switch_branches = f.switch_branches;
+  c.max_branches = f.max_branches;
+  c.method = method.settings;
+  c.steps_per_period = method.steps_per_period;
+  c.shooting = shooting_options(o);
+  c.shooting.solver = orbits::ShootingSolver::dense;
+  if (!c.is_valid(&why)) throw InputError(why);
+
+  Vector guess;
+  {
+    orbits::StroboscopicMap map(first_case, method.settings, method.steps_per_period);
+    if (!map.exact_tangent()) {
+      fmt::print("note: {} has no exact tangent map: every monodromy comes from forward "
+                 "differences of the flow (2n integrations), and the multipliers are accurate to "
+                 "about eight digits\n",
+                 method_label(method.settings));
+    }
+    guess = starting_guess(o, map);
+  }
+  std::string title = fmt::format(
+      "pwl continue in {} of the period-{} orbit (base case {}; {})", parameter.name(), o.period,
+      base.explicit_structure() ? base.structure().label : o.run.description(),
+      orbit_method_label(method));
+  // For a gnuplot title: no single quotes, underscores escaped (enhanced text's subscript).
+  title.erase(std::remove(title.begin(), title.end(), '\''), title.end());
+  for (std::size_t at = title.find('_'); at != std::string::npos; at = title.find('_', at + 2)) {
+    title.insert(at, "\\");
+  }
+  fmt::print("continuation of the period-{} orbit of n = {}, {} in {} from {} to {}, by {}{}\n",
+             o.period, n, o.run.description(), parameter.name(), from, to,
+             orbit_method_label(method), method.chosen ? " (the default for orbits)" : "");
+  fmt::print("guess at {} = {}: {}\n", parameter.name(), from,
+             o.guess_file.empty()
+                 ? fmt::format("the state {} forcing periods after rest", o.transient)
+                 : o.guess_file);
+  std::filesystem::create_directories(o.out);
+  ContinueOutputs outputs(o.out, base, parameter, method, dofs, !o.quiet);
+  orbits::ContinuationResult result;
+  try {
+    result = orbits::continue_periodic_orbit(base, guess, c, &outputs);
+  } catch (...) {
+    outputs.finish_progress();
+    throw;
+  }
+  outputs.finish_progress();
+  outputs.rewrite_bifurcations(o.out, result.bifurcations);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  fmt::print("start: Newton at {} = {}: residual {:.3e} after {} iteration(s)\n", parameter.name(),
+             from, outputs.first_residual(), outputs.first_iterations());
+  for (const auto& [branch, count] : outputs.per_branch()) {
+    const auto& [lo, hi] = outputs.range().at(branch);
+    const auto stable = outputs.stable().find(branch);
+    fmt::print("branch {} (period {}): {} points, {} from {:.10g} to {:.10g}, {} stable\n", branch,
+               outputs.period().at(branch), count, parameter.name(), lo, hi,
+               stable == outputs.stable().end() ? 0 : stable->second);
+  }
+  print_bifurcations(result.bifurcations, parameter.name());
+  if (!result.notes.empty()) {
+    fmt::print("notes:\n");
+    for (const std::string& note : result.notes) fmt::print("  {}\n", note);
+  }
+  fmt::print("time: {:.2f} s ({} points)\n", seconds, outputs.points());
+  fmt::print("wrote {0}/branch.csv, {0}/branch_section.csv and {0}/bifurcations.csv\n", o.out);
+  if (!f.no_plot) {
+    draw_frequency_response(f, outputs, result.bifurcations, dofs, parameter,
+                            !base.explicit_structure(), title);
+  }
+  if (f.over_sweep > 0) {
+    run_over_sweep(f, base, parameter, method, from, to, dofs, title);
+  }
+}
+
+}  // namespace
+
+void add_continue_command(CLI::App& app) {
+  auto flags = std::make_shared<ContinueFlags>();
+  CLI::App* c = app.add_subcommand(
+      "continue",
+      "Follow a periodic orbit in one parameter (pseudo-arclength continuation), with its\n"
+      "stability and its bifurcations: fold, period doubling, Neimark-Sacker, grazing\n"
+      "Example: pwl continue --figure 5 --parameter theta --range 0.5:3 --out theta_branch\n"
+      "         pwl continue --figure 5 --parameter theta --range 0.5:3 --switch-branches \\\n"
+      "           --over-sweep 200 --out theta_branch");
+  add_orbit_flags(*c, flags->orbit, false);
+  flags->orbit.out = "continuation";
+  c->get_option("--out")->default_str("continuation");
+  c->get_option("--transient")
+      ->description("Guess: the state this many forcing periods after rest, at the start of\n"
+                    "--range (also each --over-sweep point's transient)");
+  c->add_option("--parameter", flags->parameter,
+                "Parameter followed: theta, alpha, zeta, gap (Δ̃) or amplitude (scales Q) of the\n"
+                "chain; spring<j>.stiffness, spring<j>.gap, load<j>.amplitude, load<j>.frequency\n"
+                "or damping (scales C) of a --structure-scene (j from 1)")
+      ->required();
+  c->add_option("--range", flags->range,
+                "FROM:TO: the branch starts at FROM and is followed toward TO (either order)")
+      ->required();
+  c->add_flag("--switch-branches", flags->switch_branches,
+              "At each period doubling, follow the period-2k branch born there too");
+  c->add_option("--max-branches", flags->max_branches, "Branches switched onto, at most")
+      ->check(non_negative_number());
+  c->add_option("--max-points", flags->max_points, "Points per branch, at most")
+      ->check(positive_number());
+  c->add_option("--step", flags->step,
+                "Arclength of the first step (0: |TO − FROM|/100)")
+      ->check(non_negative_number());
+  c->add_option("--min-step", flags->min_step,
+                "Smallest step; a branch stops below it (0: 1e-7 |TO − FROM|)")
+      ->check(non_negative_number());
+  c->add_option("--max-step", flags->max_step, "Largest step (0: |TO − FROM|/25)")
+      ->check(non_negative_number());
+  c->add_option("--record", flags->record,
+                "Masses whose amplitude and state branch.csv keeps, comma separated (5 or x5);\n"
+                "the figures draw the last one. Default: every mass up to 10, else the last")
+      ->delimiter(',');
+  c->add_flag("--no-grazing", flags->no_grazing, "Do not look for grazing bifurcations");
+  c->add_option("--over-sweep", flags->over_sweep,
+                "Also run the brute-force bifurcation diagram of the range (pwl sweep by\n"
+                "continuation, up and down) with this many values into OUT/over_sweep, and draw\n"
+                "the branches over it (OUT/branch_over_diagram.png)")
+      ->check(non_negative_number());
+  c->add_option("--over-periods", flags->over_periods,
+                "Poincaré points recorded per value of --over-sweep (after --transient)")
+      ->check(positive_number());
+  c->add_flag("--no-plot", flags->no_plot, "Write the CSV files only");
+  c->add_option("--threads", flags->threads, "OpenMP threads of --over-sweep (default: all cores)")
+      ->check(non_negative_number());
+  c->callback([c, flags] {
+    read_method_given(*c, flags->orbit);
+    continue_orbit(*flags);
+  });
+}
+
+}  // namespace pwl::app
