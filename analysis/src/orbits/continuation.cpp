@@ -323,6 +323,7 @@ class Continuer {
   void follow(Point first, int branch, int period, int parent_period, std::size_t source) {
     const std::string label = fmt::format("branch {} (period {})", branch, period);
     const double first_p = first.p;
+    branch_start_ = first_p;
     std::vector<Vector> first_orbit{first.y};
     for (int j = 1; j < period; ++j) {
       try {
@@ -496,7 +497,12 @@ class Continuer {
       return std::max(std::abs(nearest_real(a.mu, target) - target),
                       std::abs(nearest_real(b.mu, target) - target)) > kNoise;
     };
-    if ((sa.real_above_one - sb.real_above_one) % 2 != 0 && clear(1.0)) {
+    // A switched branch starts at a period doubling, where its own multiplier +1 is pinned: no
+    // fold is taken within 1e-4 of the range from its start.
+    const bool at_switch = branch > 0 &&
+                           std::max(std::abs(a.p - branch_start_), std::abs(b.p - branch_start_)) <=
+                               1e-4 * (hi_ - lo_);
+    if ((sa.real_above_one - sb.real_above_one) % 2 != 0 && clear(1.0) && !at_switch) {
       found.emplace_back(BifurcationType::fold, -1);
     }
     if ((sa.real_below_minus_one - sb.real_below_minus_one) % 2 != 0 && clear(-1.0)) {
@@ -795,6 +801,7 @@ class Continuer {
   std::deque<Pending> pending_;
   int branches_ = 0;
   bool retracing_ = false;
+  double branch_start_ = 0.0;  // parameter of the first point of the branch being followed
   double initial_step_ = 0, min_step_ = 0, max_step_ = 0, lo_ = 0, hi_ = 0;
 };
 

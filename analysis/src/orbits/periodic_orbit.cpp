@@ -202,19 +202,21 @@ PeriodicOrbit find_periodic_orbit(StroboscopicMap& map, const Vector& guess,
       Eigen::PartialPivLU<Matrix> lu(J);
       const Vector delta = lu.solve(-G);
       if (!delta.allFinite()) throw fail("met a singular Jacobian (a multiplier at 1)", residual, iteration);
-      // Backtracking on the residual.
+      // Backtracking on |G|_2 (the norm whose decrease the Newton direction guarantees), down to
+      // 1/1024 of the step. The full step carries the Jacobians along; a shortened one evaluates
+      // the residual alone and the Jacobians only once accepted.
       bool accepted = false;
-      for (double lambda = 1.0; lambda >= 1.0 / 64; lambda /= 2) {
+      for (double lambda = 1.0; lambda >= 1.0 / 1024; lambda /= 2) {
         const Vector trial = Y + lambda * delta;
         try {
           std::vector<Matrix> trial_M(arcs.count);
-          Vector trial_G = shooting_residual(map, arcs, trial, &trial_M);
-          const double trial_residual = inf_norm(trial_G);
-          if (trial_G.allFinite() && trial_residual < (1 - 1e-4 * lambda) * residual) {
+          Vector trial_G = shooting_residual(map, arcs, trial, lambda == 1.0 ? &trial_M : nullptr);
+          if (trial_G.allFinite() && trial_G.norm() < (1 - 1e-4 * lambda) * G.norm()) {
+            if (lambda != 1.0) trial_G = shooting_residual(map, arcs, trial, &trial_M);
             Y = trial;
             G = std::move(trial_G);
             M = std::move(trial_M);
-            residual = trial_residual;
+            residual = inf_norm(G);
             accepted = true;
             break;
           }
@@ -282,7 +284,7 @@ PeriodicOrbit find_periodic_orbit(StroboscopicMap& map, const Vector& guess,
     previous_residual = residual;
     if (!delta.allFinite()) throw fail("met a singular Jacobian (a multiplier at 1)", residual, iteration);
     bool accepted = false;
-    for (double lambda = 1.0; lambda >= 1.0 / 64; lambda /= 2) {
+    for (double lambda = 1.0; lambda >= 1.0 / 1024; lambda /= 2) {
       const Vector trial = y + lambda * delta;
       try {
         Vector trial_F = map.advance(trial, options.period) - trial;

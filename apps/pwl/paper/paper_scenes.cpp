@@ -53,6 +53,13 @@ const std::vector<ReproducedScene>& reproduced_scenes() {
        {},
        {"map.x_points=5", "map.y_points=4", "run.transient=50", "run.periods=100"},
        {{"regime_map", "regime_map_theta_alpha"}, {"lambda1_map", "lambda1_map_theta_alpha"}}},
+      {"continuation",
+       "five_dof_continuation.toml",
+       {},
+       {"continuation.range=0.65:0.72", "continuation.over_sweep=8", "continuation.over_periods=40",
+        "run.transient=50"},
+       {{"frequency_response", "frequency_response_theta"},
+        {"branch_over_diagram", "branches_over_diagram_theta"}}},
   };
   return scenes;
 }

@@ -27,8 +27,8 @@
 // and R. D. Russell, Numerical Solution of Boundary Value Problems for ODEs, SIAM 1995, ch. 4).
 // Only the dense form supports it.
 //
-// Globalisation: a step that does not decrease |F| is halved (backtracking on the residual) down
-// to 1/64; Newton stops with a ShootingError that says the residual reached when it cannot go on.
+// Globalisation: a step that does not decrease |F|_2 enough is halved (backtracking) down to
+// 1/1024; Newton stops with a ShootingError that says the residual reached when it cannot go on.
 #include <string>
 #include <vector>
 

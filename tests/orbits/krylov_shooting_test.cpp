@@ -1,0 +1,145 @@
+// Matrix-free shooting against the dense form: on a 50-mass chain (100 state components, springs
+// that open and close every period), Newton-Krylov (GMRES on tangent products) and dense Newton
+// (the whole monodromy, LU) must land on the same orbit, and restarted Arnoldi's leading Floquet
+// multipliers must be the leading eigenvalues of the dense monodromy. Restarted Arnoldi alone on a
+// matrix whose eigenvalues are known by construction.
+#include <Eigen/QR>
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <complex>
+#include <random>
+
+#include "orbit_cases.hpp"
+#include "pwl/model/chain_builders.hpp"
+#include "pwl/orbits/orbit_profile.hpp"
+#include "pwl/orbits/periodic_orbit.hpp"
+
+using namespace pwl;
+using namespace pwl::orbits;
+using pwl::test::measured;
+using pwl::test::set_distance;
+using Complex = std::complex<double>;
+
+TEST_CASE("Newton-Krylov and dense Newton find the same periodic orbit of a 50-mass chain",
+          "[orbits]") {
+  NondimensionalChain chain;
+  chain.masses = 50;
+  chain.alpha = {2.0};
+  chain.gap = {0.0};
+  chain.amplitude = {1.0};
+  chain.theta = 1.5;
+  // A 100x100 problem gains nothing from Eigen's threads, and on a loaded machine their spinning
+  // costs seconds.
+  Eigen::setNbThreads(1);
+  // The dense PIM has the exact tangent map (the banded form, which "pim" picks beyond 50 masses,
+  // would give forward-difference products of about eight digits).
+  StroboscopicMap map(analysis::PointCase(chain), MethodSettings{Method::pim_dense}, 100);
+  REQUIRE(map.exact_tangent());
+  // From the steady response of the chain with its springs open: the slow modes' multipliers are
+  // within 1e-3 of the unit circle, so a seed from the transient would take thousands of periods.
+  const Vector seed = pwl::test::harmonic_response(map.structure(), chain.theta);
+
+  ShootingOptions options;
+  options.tolerance = 1e-12;
+  options.solver = ShootingSolver::dense;
+  const PeriodicOrbit dense = find_periodic_orbit(map, seed, options);
+  options.solver = ShootingSolver::krylov;
+  options.arnoldi.count = 6;
+  const PeriodicOrbit krylov = find_periodic_orbit(map, seed, options);
+  REQUIRE(dense.solver == ShootingSolver::dense);
+  REQUIRE(krylov.solver == ShootingSolver::krylov);
+  CHECK(krylov.monodromy.size() == 0);
+
+  // Contacts open and close along it (not a linear problem in disguise).
+  const OrbitProfile profile = orbit_profile(map, dense.state, 1);
+  const auto touching = (profile.max_gap.array() > 0).count();
+  CHECK(touching > 0);
+  CHECK(touching < 50);
+
+  const double difference = (krylov.state - dense.state).lpNorm<Eigen::Infinity>();
+  measured(
+      "krylov vs dense orbit (|y| " + std::to_string(dense.state.lpNorm<Eigen::Infinity>()) + ")",
+      difference);
+  CHECK(difference <= 1e-9);
+  CHECK(krylov.residual <= 1e-12 * std::max(1.0, krylov.state.lpNorm<Eigen::Infinity>()));
+
+  // The leading six: lightly damped slow modes, three complex pairs just inside the unit circle.
+  REQUIRE(dense.multipliers.values.size() == 100);
+  REQUIRE(krylov.multipliers.values.size() == 6);
+  CHECK_FALSE(krylov.multipliers.complete);
+  const std::vector<Complex> leading(dense.multipliers.values.begin(),
+                                     dense.multipliers.values.begin() + 6);
+  const double distance = set_distance(leading, krylov.multipliers.values);
+  measured("Arnoldi vs dense leading multipliers", distance);
+  CHECK(distance <= 1e-8);
+  CHECK(krylov.multipliers.largest_modulus() > 0.99);
+  CHECK(krylov.stable());
+}
+
+TEST_CASE(
+    "restarted Arnoldi finds the leading eigenvalues of a matrix built with them (orbit "
+    "multipliers)",
+    "[orbits]") {
+  // A = S D S⁻¹, S a random well-conditioned basis, D with 2x2 rotation-scaling blocks for the
+  // complex pairs. The leading six: 0.98 e^{±0.4i}, −0.96, 0.93 e^{±2.2i}, 0.9; the other 194 lie
+  // in a disc of radius 0.8.
+  const Index n = 200;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Matrix D = Matrix::Zero(n, n);
+  std::vector<Complex> expected;
+  const auto pair = [&](Index i, double r, double phi) {
+    D(i, i) = D(i + 1, i + 1) = r * std::cos(phi);
+    D(i, i + 1) = r * std::sin(phi);
+    D(i + 1, i) = -r * std::sin(phi);
+  };
+  pair(0, 0.98, 0.4);
+  D(2, 2) = -0.96;
+  pair(3, 0.93, 2.2);
+  D(5, 5) = 0.9;
+  expected = {std::polar(0.98, 0.4), std::polar(0.98, -0.4), Complex(-0.96, 0),
+              std::polar(0.93, 2.2), std::polar(0.93, -2.2), Complex(0.9, 0)};
+  for (Index i = 6; i + 1 < n; i += 2) pair(i, 0.8 * std::abs(u(rng)), 3.2 * u(rng));
+  Matrix random(n, n);
+  for (Index i = 0; i < n; ++i)
+    for (Index j = 0; j < n; ++j) random(i, j) = u(rng);
+  const Matrix Q = Eigen::HouseholderQR<Matrix>(random).householderQ();
+  const Matrix S = Q * (Matrix::Identity(n, n) + 0.05 * random / std::sqrt(double(n)));
+  const Matrix A = S * D * S.inverse();
+  long products = 0;
+  const auto apply = [&](Matrix& v) {
+    products += v.cols();
+    v = A * v;
+  };
+
+  ArnoldiOptions options;
+  options.count = 6;
+  options.krylov_dimension = 20;
+  options.tolerance = 1e-12;
+  options.max_restarts = 0;
+  const FloquetMultipliers once = leading_floquet_multipliers(apply, n, options);
+  measured("Arnoldi without restarts: residual", once.residual);
+  CHECK(once.residual > 1e-12);  // 20 vectors are not enough ...
+  options.max_restarts = 60;
+  products = 0;
+  const FloquetMultipliers restarted = leading_floquet_multipliers(apply, n, options);
+  measured("restarted Arnoldi: residual", restarted.residual);
+  measured("restarted Arnoldi: products", static_cast<double>(products));
+  CHECK(restarted.residual <= 1e-12);  // ... restarts are
+  CHECK_FALSE(restarted.complete);
+  const double distance = set_distance(expected, restarted.values);
+  measured("restarted Arnoldi eigenvalue error", distance);
+  CHECK(distance <= 1e-10);
+  // Sorted: largest modulus first, the pair's positive imaginary part first.
+  REQUIRE(restarted.values.size() == 6);
+  CHECK(restarted.values[0].imag() > 0);
+  CHECK(restarted.values[2].real() == Approx(-0.96).epsilon(1e-10));
+  CHECK(restarted.largest_modulus() == Approx(0.98).epsilon(1e-10));
+  // Every eigenvalue of a 6x6 matrix: complete, and exactly those of the dense solver.
+  const Matrix small = A.topLeftCorner(6, 6);
+  options.max_restarts = 5;
+  const FloquetMultipliers all =
+      leading_floquet_multipliers([&](Matrix& v) { v = small * v; }, 6, options);
+  CHECK(all.complete);
+  CHECK(set_distance(floquet_multipliers(small).values, all.values) <= 1e-12);
+}

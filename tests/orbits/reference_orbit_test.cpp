@@ -1,0 +1,67 @@
+// Orbits found by shooting on the exact solver, checked by an independent integrator: the
+// kink-located rkf78 at tolerance 1e-13 (every step ends at a spring switch, so it keeps its
+// order). Started on the orbit it must come back to it after k periods, and the Floquet
+// multipliers from Richardson-extrapolated central differences of its flow (no tangent map at all)
+// must be those of the exact tangent. Figure 4a's chain: the unstable period-1 orbit and the
+// stable period-2 orbit the paper shows.
+#include <catch2/catch.hpp>
+#include <string>
+
+#include "orbit_cases.hpp"
+#include "pwl/model/chain_builders.hpp"
+#include "pwl/orbits/periodic_orbit.hpp"
+
+using namespace pwl;
+using namespace pwl::orbits;
+using pwl::test::measured;
+
+namespace {
+
+MethodSettings reference_method() {
+  MethodSettings m;
+  m.method = Method::rkf78;
+  m.tolerance = 1e-13;
+  m.locate_kinks = true;
+  return m;
+}
+
+void check_with_reference(StroboscopicMap& reference, const PeriodicOrbit& orbit,
+                          const std::string& label) {
+  INFO(label);
+  CHECK_FALSE(reference.exact_tangent());
+  const double closure =
+      (reference.advance(orbit.state, orbit.period) - orbit.state).lpNorm<Eigen::Infinity>();
+  measured(label + ": |rkf78(y*) - y*|", closure);
+  CHECK(closure <= 1e-10);
+  // h = 1e-3: the O(h⁴) truncation (~1e-10 here) and rkf78's noise amplified by 1/h (~1e-10)
+  // balance.
+  const Matrix M = pwl::test::central_differences(reference, orbit.state, orbit.period, 1e-3, true);
+  const double scale = std::max(1.0, orbit.monodromy.cwiseAbs().maxCoeff());
+  const double monodromy = (M - orbit.monodromy).cwiseAbs().maxCoeff() / scale;
+  const double multipliers =
+      pwl::test::set_distance(floquet_multipliers(M).values, orbit.multipliers.values);
+  measured(label + ": monodromy vs rkf78 differences", monodromy);
+  measured(label + ": multipliers vs rkf78 differences", multipliers);
+  CHECK(monodromy <= 2e-9);
+  CHECK(multipliers <= 1e-9);
+}
+
+}  // namespace
+
+TEST_CASE("figure 4a's periodic orbits close under kink-located rkf78 at 1e-13", "[orbits]") {
+  const NondimensionalChain chain = paper_five_dof_case("4a");
+  StroboscopicMap exact(analysis::PointCase(chain), MethodSettings{Method::exact}, 1);
+  StroboscopicMap reference(analysis::PointCase(chain), reference_method(), 1);
+  const auto points = pwl::test::poincare_points(exact, Vector::Zero(10), 500, 2);
+  ShootingOptions options;
+  options.tolerance = 1e-13;
+  options.period = 2;
+  const PeriodicOrbit two = find_periodic_orbit(exact, points.back(), options);
+  REQUIRE(two.residual <= 1e-12);
+  check_with_reference(reference, two, "4a period-2");
+  options.period = 1;
+  const PeriodicOrbit one = find_periodic_orbit(exact, 0.5 * (points[0] + points[1]), options);
+  REQUIRE(one.residual <= 1e-12);
+  CHECK(one.multipliers.largest_modulus() > 2);  // unstable: rkf78's error grows 2.2x per period
+  check_with_reference(reference, one, "4a period-1");
+}
