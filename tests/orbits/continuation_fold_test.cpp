@@ -25,23 +25,12 @@ using pwl::test::measured;
 
 namespace {
 
-NondimensionalChain oscillator(double theta) {
-  NondimensionalChain c;
-  c.masses = 1;
-  c.alpha = {3.0};
-  c.zeta = 0.1;
-  c.gap = {1.5};
-  c.amplitude = {0.5};
-  c.theta = theta;
-  return c;
-}
-
 ContinuationResult continue_across_hysteresis() {
   ContinuationOptions o;
   o.parameter = analysis::SweepParameter::theta;
   o.start = 0.8;
   o.end = 2.0;
-  return continue_periodic_orbit(analysis::PointModel(oscillator(0.8)), Vector::Zero(2), o);
+  return continue_periodic_orbit(analysis::PointModel(pwl::test::hardening_oscillator(0.8)), Vector::Zero(2), o);
 }
 
 std::vector<double> folds_of(const ContinuationResult& r) {
@@ -66,7 +55,7 @@ std::vector<Jump> sweep_jumps(double first, double step, int count, int periods)
   double previous = -1;
   for (int i = 0; i < count; ++i) {
     const double theta = first + i * step;
-    const NondimensionalChain c = oscillator(theta);
+    const NondimensionalChain c = pwl::test::hardening_oscillator(theta);
     EventDrivenSolver solver(make_chain(c));
     solver.set_state(0.0, y.head(1), y.tail(1));
     solver.advance_to(periods * c.period());
@@ -85,7 +74,7 @@ double theta_on_branch(int c, double s, Vector& y, double& theta) {
   const int other = 1 - c;
   y(c) = s;
   const auto residual = [&](const Vector& state, double th, Matrix* M) {
-    StroboscopicMap map(analysis::PointCase(oscillator(th)), MethodSettings{Method::exact}, 1);
+    StroboscopicMap map(analysis::PointCase(pwl::test::hardening_oscillator(th)), MethodSettings{Method::exact}, 1);
     if (M != nullptr) return Vector(map.advance_with_jacobian(state, 1, *M) - state);
     return Vector(map.advance(state, 1) - state);
   };

@@ -20,17 +20,6 @@ using pwl::test::measured;
 
 namespace {
 
-NondimensionalChain oscillator(double theta) {
-  NondimensionalChain c;
-  c.masses = 1;
-  c.alpha = {3.0};
-  c.zeta = 0.1;
-  c.gap = {1.5};
-  c.amplitude = {0.5};
-  c.theta = theta;
-  return c;
-}
-
 // The zero of amplitude(θ) − 1.5 in [a, b], by bisection.
 double linear_grazing(double a, double b) {
   const auto f = [](double theta) {
@@ -47,7 +36,7 @@ double linear_grazing(double a, double b) {
 
 // The contact events in one period of the orbit at θ, found by Newton from `guess`.
 std::size_t events_per_period(double theta, const Vector& guess) {
-  const analysis::PointCase point(oscillator(theta));
+  const analysis::PointCase point(pwl::test::hardening_oscillator(theta));
   StroboscopicMap map(point, MethodSettings{Method::exact}, 1);
   ShootingOptions options;
   options.tolerance = 1e-13;
@@ -63,7 +52,7 @@ TEST_CASE("grazing points of the gap oscillator's orbit branch are located to 1e
   o.start = 0.8;
   o.end = 2.0;
   const ContinuationResult r =
-      continue_periodic_orbit(analysis::PointModel(oscillator(0.8)), Vector::Zero(2), o);
+      continue_periodic_orbit(analysis::PointModel(pwl::test::hardening_oscillator(0.8)), Vector::Zero(2), o);
   std::vector<Bifurcation> grazings;
   for (const Bifurcation& b : r.bifurcations) {
     if (b.type == BifurcationType::grazing) grazings.push_back(b);

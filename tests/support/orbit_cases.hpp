@@ -12,6 +12,7 @@
 
 #include "pwl/integrators/event_driven_solver.hpp"
 #include "pwl/integrators/integrator.hpp"
+#include "pwl/model/chain_builders.hpp"
 #include "pwl/model/gap_structure.hpp"
 #include "pwl/orbits/stroboscopic_map.hpp"
 #include "pwl/study/point_model.hpp"
@@ -31,6 +32,20 @@ inline Vector state_of(const Integrator& integrator) {
   Vector y(2 * integrator.dofs());
   y << integrator.position(), integrator.velocity();
   return y;
+}
+
+// The hardening gap oscillator of the continuation-sweep test (tests/study/parameter_sweep_test):
+// one mass of the nondimensional chain, α = 3, ζ = 0.1, Δ̃ = 1.5, Q = 0.5; its resonance bends to
+// higher θ once the mass reaches the gap, with two folds and hysteresis between them.
+inline NondimensionalChain hardening_oscillator(double theta) {
+  NondimensionalChain c;
+  c.masses = 1;
+  c.alpha = {3.0};
+  c.zeta = 0.1;
+  c.gap = {1.5};
+  c.amplitude = {0.5};
+  c.theta = theta;
+  return c;
 }
 
 // x'' + 2ζ x' + x + α max(0, x − Δ) = q sin(θ t): one unit mass, one gap spring to the ground.

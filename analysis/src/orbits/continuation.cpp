@@ -228,47 +228,10 @@ class Continuer {
     return (plus - minus) / (2 * delta);
   }
 
-  // Newton on F(y, p) = 0 with τ · ((y, p) − prediction) = 0 from the prediction. `b` is ∂F/∂p
-  // near the prediction (kept fixed: the chord in that column only).
+  // Newton on F(y, p) = 0 with τ · ((y, p) − prediction) = 0, from the prediction itself.
   std::optional<Point> correct(const Vector& y_pred, double p_pred, const Vector& tau,
                                const Vector& b, int period) {
-    const Index N = y_pred.size();
-    Point pt;
-    pt.y = y_pred;
-    pt.p = p_pred;
-    for (int it = 0; it <= options_.max_corrections; ++it) {
-      Vector F;
-      try {
-        F = residual(pt.y, pt.p, period, &pt.M);
-      } catch (const Error&) {
-        return std::nullopt;  // the motion blew up or the structure became invalid
-      }
-      if (!F.allFinite()) return std::nullopt;
-      const double res = F.lpNorm<Eigen::Infinity>();
-      const double scale = std::max(1.0, pt.y.lpNorm<Eigen::Infinity>());
-      if (res <= options_.shooting.tolerance * scale) {
-        pt.residual = res;
-        pt.iterations = it;
-        pt.mu = floquet_multipliers(pt.M);
-        return pt;
-      }
-      if (it == options_.max_corrections) return std::nullopt;
-      Matrix A(N + 1, N + 1);
-      A.topLeftCorner(N, N) = pt.M - Matrix::Identity(N, N);
-      A.topRightCorner(N, 1) = b;
-      A.bottomRows(1) = tau.transpose();
-      Vector rhs(N + 1);
-      rhs.head(N) = -F;
-      rhs(N) = -(tau.head(N).dot(pt.y - y_pred) + tau(N) * (pt.p - p_pred));
-      const Vector d = Eigen::PartialPivLU<Matrix>(A).solve(rhs);
-      if (!d.allFinite()) return std::nullopt;
-      pt.y += d.head(N);
-      pt.p += d(N);
-      if (!std::isfinite(pt.p)) return std::nullopt;
-      std::string why;
-      if (!model_.accepts(options_.parameter, pt.p, &why)) return std::nullopt;
-    }
-    return std::nullopt;
+    return correct_from(y_pred, p_pred, y_pred, p_pred, tau, b, period, options_.max_corrections);
   }
 
   // The tangent at a corrected point, oriented like `previous`.
@@ -594,7 +557,7 @@ class Continuer {
       const Vector y_pred = a.y + s * a.tangent.head(N);
       const double p_pred = a.p + s * a.tangent(N);
       std::optional<Point> pt = correct_from(y_guess, p_guess, y_pred, p_pred, a.tangent, a.b,
-                                             period);
+                                             period, options_.max_corrections + 3);
       if (!pt) {
         located = false;
         break;
@@ -663,17 +626,17 @@ class Continuer {
     return std::abs(x) < std::abs(y);
   }
 
-  // correct() started from a guess other than the prediction.
+  // Newton on F(y, p) = 0 with the constraint τ · ((y, p) − (y_pred, p_pred)) = 0, started from
+  // (y_guess, p_guess), at most `corrections` iterations. `b` is ∂F/∂p near the prediction (kept
+  // fixed: the chord in that column only). Empty when it does not converge or the motion blows up.
   std::optional<Point> correct_from(const Vector& y_guess, double p_guess, const Vector& y_pred,
-                                    double p_pred, const Vector& tau, const Vector& b,
-                                    int period) {
-    // Shift the constraint so that the guess is the "prediction" plane's point: solve with the
-    // constraint τ · ((y, p) − (y_pred, p_pred)) = 0 starting from the guess.
+                                    double p_pred, const Vector& tau, const Vector& b, int period,
+                                    int corrections) {
     const Index N = y_guess.size();
     Point pt;
     pt.y = y_guess;
     pt.p = p_guess;
-    for (int it = 0; it <= options_.max_corrections + 3; ++it) {
+    for (int it = 0; it <= corrections; ++it) {
       Vector F;
       try {
         F = residual(pt.y, pt.p, period, &pt.M);
@@ -726,7 +689,8 @@ class Continuer {
     const Vector b0 = parameter_derivative(pd.at.y, pd.at.p, period);
     for (double eps : {1e-3, 1e-2, 3e-2, 1e-4}) {
       const Vector y_pred = pd.at.y + eps * scale * v;
-      std::optional<Point> pt = correct_from(y_pred, pd.at.p, y_pred, pd.at.p, tau0, b0, period);
+      std::optional<Point> pt = correct_from(y_pred, pd.at.p, y_pred, pd.at.p, tau0, b0, period,
+                                             options_.max_corrections + 3);
       if (!pt) continue;
       // A genuine period-2k orbit: not a fixed point of the period-k map.
       Vector Fk;
