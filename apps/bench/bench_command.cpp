@@ -3,6 +3,8 @@
 //   pwl bench scaling    time per step and memory of the banded PIM as the chain grows
 //   pwl bench accuracy   work-precision diagrams (accuracy_bench.hpp)
 //   pwl bench stability  where each method breaks as the contacts stiffen (accuracy_bench.hpp)
+//   pwl bench sweep      a θ sweep of the 5-DOF chain (bench_sweep.hpp)
+//   pwl bench orbits     periodic orbits by shooting against brute force, continuation (bench_orbits.hpp)
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -13,6 +15,7 @@
 #include "commands/cli_checks.hpp"
 #include "bench/accuracy_bench.hpp"
 #include "bench/bench_chain.hpp"
+#include "bench/bench_orbits.hpp"
 #include "bench/bench_scaling.hpp"
 #include "bench/bench_sweep.hpp"
 #include "bench/chain_figures.hpp"
@@ -127,6 +130,7 @@ void add_bench_command(CLI::App& app) {
   add_scaling(*bench);
   add_accuracy_benches(*bench);
   add_sweep_bench(*bench);
+  add_orbits_bench(*bench);
 }
 
 }  // namespace pwl::app

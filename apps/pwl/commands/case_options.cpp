@@ -4,6 +4,7 @@
 #include <fmt/ranges.h>
 
 #include <cmath>
+#include <filesystem>
 
 #include "commands/cli_checks.hpp"
 #include "pwl/errors.hpp"
@@ -120,6 +121,12 @@ double CaseOptions::step(double period) const {
         period, ratio));
   }
   return period / std::round(ratio);
+}
+
+analysis::PointModel CaseOptions::model() const {
+  if (!explicit_structure()) return analysis::PointModel(chain());
+  return analysis::PointModel(analysis::ExplicitStructure{
+      structure(), description(), std::filesystem::path(structure_scene).filename().string()});
 }
 
 MethodSettings CaseOptions::method_settings(double period) const {

@@ -10,6 +10,7 @@
 #include "pwl/model/chain_builders.hpp"
 #include "pwl/integrators/integrator.hpp"
 #include "pwl/integrators/method_table.hpp"
+#include "pwl/study/point_model.hpp"
 
 namespace pwl::app {
 
@@ -40,6 +41,10 @@ struct CaseOptions {
   bool explicit_structure() const { return !structure_scene.empty(); }
   // The structure: the chain's, or the scene file's explicit one.
   GapStructure structure() const;
+  // The point model these flags describe (study/point_model.hpp): the chain, or the explicit
+  // structure of --structure-scene; what sweeps, maps and orbits vary. Throws InputError for flags
+  // that do not make a valid model.
+  analysis::PointModel model() const;
   // The forcing period: the chain's, or the common period of the explicit structure's loads.
   double period() const;
   // A short description for titles and messages.

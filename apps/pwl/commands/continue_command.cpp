@@ -409,7 +409,7 @@ void continue_orbit(const ContinueFlags& f) {
   const auto start = std::chrono::steady_clock::now();
   const OrbitFlags& o = f.orbit;
   check_orbit_flags(o);
-  const analysis::PointModel base = point_model(o.run);
+  const analysis::PointModel base = o.run.model();
   if (f.parameter.empty()) throw InputError("--parameter: name the parameter to follow");
   const analysis::SweepParameter parameter = parse_model_parameter(base, "--parameter", f.parameter);
   if (f.range.empty()) throw InputError("--range: give the range as FROM:TO");

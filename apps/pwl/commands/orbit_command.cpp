@@ -59,7 +59,7 @@ void orbit(const OrbitCommandFlags& f) {
   const OrbitFlags& o = f.orbit;
   check_orbit_flags(o);
   if (f.shots < 1) throw InputError(fmt::format("--shots = {} must be >= 1", f.shots));
-  const analysis::PointModel model = point_model(o.run);
+  const analysis::PointModel model = o.run.model();
   const analysis::PointCase point = model.point_case();
   const Index n = point.structure.dofs();
   const OrbitMethod method = orbit_method(o, point.structure, point.period);

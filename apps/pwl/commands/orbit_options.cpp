@@ -67,13 +67,6 @@ void add_orbit_flags(CLI::App& c, OrbitFlags& f, bool with_dt) {
 
 void read_method_given(const CLI::App& c, OrbitFlags& f) { f.method_given = c.count("--method") > 0; }
 
-analysis::PointModel point_model(const CaseOptions& run) {
-  if (!run.explicit_structure()) return analysis::PointModel(run.chain());
-  return analysis::PointModel(analysis::ExplicitStructure{
-      run.structure(), run.description(),
-      std::filesystem::path(run.structure_scene).filename().string()});
-}
-
 OrbitMethod orbit_method(const OrbitFlags& f, const GapStructure& structure, double period) {
   OrbitMethod m;
   CaseOptions run = f.run;

@@ -34,11 +34,6 @@ void add_orbit_flags(CLI::App& command, OrbitFlags& flags, bool with_dt);
 // To be called from the command's callback: records whether --method was given.
 void read_method_given(const CLI::App& command, OrbitFlags& flags);
 
-// The point model of the case flags: the chain, or the explicit structure of --structure-scene
-// (the same model `pwl sweep` and `pwl map` build from their flags, ModelFlags::model, here with
-// the case flags' --gaps too). Throws InputError for flags that do not make a valid model.
-analysis::PointModel point_model(const CaseOptions& run);
-
 // The integrator of an orbit. Without --method: the exact event-driven solver for a structure of
 // at most 20 degrees of freedom and 62 gap springs (exact multipliers, no step error), else the
 // switching PIM (a fixed grid of --steps-per-period steps, high order, exact tangent map).

@@ -35,9 +35,7 @@ analysis::PointModel ModelFlags::model() const {
   c.theta = theta;
   c.loads = loads;
   c.structure_scene = structure_scene;
-  if (!c.explicit_structure()) return analysis::PointModel(c.chain());
-  return analysis::PointModel(analysis::ExplicitStructure{
-      c.structure(), c.description(), fs::path(structure_scene).filename().string()});
+  return c.model();
 }
 
 void add_model_flags(CLI::App& c, ModelFlags& f) {

@@ -1,0 +1,746 @@
+#include "bench/bench_orbits.hpp"
+
+#include <fmt/format.h>
+
+#include <ctime>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "commands/cli_checks.hpp"
+#include "pwl/errors.hpp"
+#include "pwl/integrators/method_table.hpp"
+#include "pwl/model/chain_builders.hpp"
+#include "pwl/orbits/continuation.hpp"
+#include "pwl/orbits/periodic_orbit.hpp"
+#include "pwl/orbits/stroboscopic_map.hpp"
+#include "pwl/study/point_model.hpp"
+
+namespace pwl::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using orbits::ShootingSolver;
+
+struct OrbitBenchOptions {
+  int repeats = 3;
+  bool quick = false;
+  int transient = 20;             // periods from rest: the common guess
+  double tolerance = 1e-10;       // shooting and brute force alike
+  // Brute-force budgets in periods: the 5-DOF cases, the medium chain, the large chain.
+  std::vector<long> settle_periods{10000, 60000, 2000};
+  std::vector<int> sizes{100, 1000};  // the medium and the large chain
+  int points = 200;                   // continuation points per branch
+  std::vector<std::string> cases;     // only these (keys below); empty: all
+  std::string out = "out/bench";
+  bool quiet = false;
+};
+
+// Keys of --cases.
+const std::vector<std::string>& case_keys() {
+  static const std::vector<std::string> keys{"4a",      "4a-stable",   "medium",
+                                             "large",   "continue-5",  "continue-medium"};
+  return keys;
+}
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// CPU time of the process (all threads): on a machine shared with other jobs the wall clock also
+// counts the time spent waiting for a core.
+double cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// Wall and CPU time of one run.
+struct Stopwatch {
+  Clock::time_point wall = Clock::now();
+  double cpu = cpu_seconds();
+  double wall_seconds() const { return seconds_since(wall); }
+  double cpu_seconds_since() const { return cpu_seconds() - cpu; }
+};
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+double inf_norm(const Vector& v) { return v.size() == 0 ? 0.0 : v.lpNorm<Eigen::Infinity>(); }
+
+// The figure 4a chain (α = 2, ζ = 0.2, Δ̃ = 0, Q = +1, −1, +1, ... on alternate masses) with
+// `masses` masses at forcing frequency θ: for 5 masses exactly the paper's case.
+NondimensionalChain fig4a_chain(int masses, double theta) {
+  NondimensionalChain c = paper_five_dof_case("4a");
+  c.masses = masses;
+  c.theta = theta;
+  c.amplitude.assign(static_cast<std::size_t>(masses), 1.0);
+  for (int i = 1; i < masses; i += 2) c.amplitude[static_cast<std::size_t>(i)] = -1.0;
+  return c;
+}
+
+// ---------------------------------------------------------------------------------------------
+// 1. Shooting against brute force.
+
+struct ShootingCase {
+  std::string key;      // of --cases
+  std::string label;    // for the table
+  NondimensionalChain chain;
+  Method method = Method::exact;
+  std::vector<ShootingSolver> solvers;
+  long settle_budget = 0;  // periods
+};
+
+struct ShootingRow {
+  std::string case_label;
+  int masses = 0;
+  std::string method;
+  bool exact_tangent = true;
+  ShootingSolver solver = ShootingSolver::dense;
+  int repeats = 0;
+  double setup = 0.0;    // median, s: the integrator's construction
+  double seconds = 0.0;  // median, s: Newton and the multipliers (wall clock)
+  double cpu = 0.0;      // median CPU time of the same, s
+  bool converged = false;
+  std::string failure;   // Newton's message when it did not converge
+  int iterations = 0;
+  long evaluations = 0;
+  long krylov_products = 0;
+  bool preconditioned = false;
+  double residual = 0.0;
+  double radius = 0.0;   // largest modulus of the multipliers
+  int multipliers = 0;   // how many were computed
+  bool complete = true;  // all of them (dense) or the leading ones (Arnoldi)
+  bool multipliers_converged = true;
+  double arnoldi_residual = 0.0;
+  bool stable = false;
+  Vector state;
+};
+
+struct BruteForce {
+  bool ran = false;
+  bool settled = false;
+  bool diverged = false;
+  long periods = 0;            // periods integrated
+  double difference = 0.0;     // |P(y) − y| at the last period
+  double distance = -1.0;      // |y − orbit| at the end (-1: no orbit to compare with)
+  double start_distance = -1.0;    // ... at the guess
+  double halfway_distance = -1.0;  // ... after half the budget (when it got there)
+  double seconds = 0.0;        // median, s (wall clock)
+  double cpu = 0.0;            // median CPU time, s
+  // Not settled but approaching the orbit: the periods still needed at the rate of the budget's
+  // second half (-1: no estimate).
+  double more_periods = -1.0;
+  int repeats = 0;
+};
+
+struct ShootingGroup {
+  ShootingCase spec;
+  std::vector<ShootingRow> rows;
+  BruteForce brute;
+};
+
+std::string stable_text(const ShootingRow& r) {
+  if (!r.converged) return "-";
+  if (!r.multipliers_converged) return "undetermined (Arnoldi not converged)";
+  return r.stable ? "yes" : "no";
+}
+
+std::string method_text(const ShootingRow& r) {
+  return fmt::format("{} ({} tangent)", r.method, r.exact_tangent ? "exact" : "finite-difference");
+}
+
+std::string brute_text(const ShootingGroup& g) {
+  const BruteForce& b = g.brute;
+  if (!b.ran) return "not run";
+  const ShootingRow* orbit = nullptr;
+  for (const ShootingRow& r : g.rows) {
+    if (r.converged) {
+      orbit = &r;
+      break;
+    }
+  }
+  std::string head;
+  if (orbit != nullptr && orbit->multipliers_converged && !orbit->stable) {
+    head = fmt::format("cannot find it (unstable, ρ = {:.3g}); ", orbit->radius);
+  }
+  if (b.diverged) return head + fmt::format("blew up after {} periods", b.periods);
+  if (b.settled) {
+    if (b.distance < 0) return head + fmt::format("settled in {} periods (no orbit to compare)", b.periods);
+    const double scale = orbit != nullptr ? std::max(1.0, inf_norm(orbit->state)) : 1.0;
+    if (b.distance <= 1e-6 * scale) {
+      return head + fmt::format("settled in {} periods on the same orbit (apart by {:.1e})",
+                                b.periods, b.distance);
+    }
+    return head + fmt::format("settled in {} periods on another orbit ({:.2g} away)", b.periods,
+                              b.distance);
+  }
+  std::string text = head + fmt::format("not settled in {} periods: successive points {:.1e} apart",
+                                        b.periods, b.difference);
+  if (b.distance >= 0) {
+    text += fmt::format("; distance to the orbit {:.2g} at the start", b.start_distance);
+    if (b.halfway_distance >= 0) text += fmt::format(", {:.2g} halfway", b.halfway_distance);
+    text += fmt::format(", {:.2g} at the end", b.distance);
+    if (b.more_periods > 0) {
+      text += fmt::format(" (at the rate of the second half, about {:.2g} more periods)",
+                          b.more_periods);
+    } else if (head.empty() && b.halfway_distance >= 0) {
+      text += " (not approaching it over the budget)";
+    }
+  }
+  return text;
+}
+
+// Brute force over shooting, with ">=" when brute force did not settle (its time is then a lower
+// bound of what settling would take) and "-" when it cannot find the orbit.
+std::string ratio_text(const ShootingGroup& g, const ShootingRow& r) {
+  const BruteForce& b = g.brute;
+  if (!b.ran || !r.converged || r.seconds <= 0) return "-";
+  if (r.multipliers_converged && !r.stable) return "- (unstable)";
+  const double ratio = b.seconds / r.seconds;
+  const bool same = b.settled && b.distance >= 0 &&
+                    b.distance <= 1e-6 * std::max(1.0, inf_norm(r.state));
+  if (same) return fmt::format("{:.3g}", ratio);
+  if (b.settled) return fmt::format("{:.3g} (another orbit)", ratio);
+  if (b.diverged) return "-";
+  std::string text = fmt::format(">= {:.3g}", ratio);
+  if (b.more_periods > 0) {
+    const double estimate = b.seconds / static_cast<double>(b.periods) *
+                            (static_cast<double>(b.periods) + b.more_periods) / r.seconds;
+    text += fmt::format(" (about {:.2g} to settle, estimated)", estimate);
+  }
+  return text;
+}
+
+orbits::StroboscopicMap make_map(const ShootingCase& c, int steps_per_period) {
+  MethodSettings settings;
+  settings.method = c.method;
+  return orbits::StroboscopicMap(analysis::PointCase(c.chain), settings, steps_per_period);
+}
+
+void run_shooting(ShootingGroup& g, const OrbitBenchOptions& o,
+                  const std::function<void(const std::string&)>& say) {
+  constexpr int kSteps = 200;  // per forcing period (fixed-grid methods)
+  const ShootingCase& c = g.spec;
+  const std::string method = std::string(method_traits(c.method).name);
+  // The common guess: the state after a short transient from rest.
+  Vector guess;
+  {
+    orbits::StroboscopicMap map = make_map(c, kSteps);
+    guess = Vector::Zero(map.state_size());
+    if (o.transient > 0) guess = map.advance(guess, o.transient);
+  }
+  for (ShootingSolver solver : c.solvers) {
+    ShootingRow row;
+    row.case_label = c.label;
+    row.masses = c.chain.masses;
+    row.method = method;
+    row.solver = solver;
+    orbits::ShootingOptions shooting;
+    shooting.solver = solver;
+    shooting.tolerance = o.tolerance;
+    std::vector<double> setups, times, cpus;
+    for (int r = 0; r < o.repeats; ++r) {
+      say(fmt::format("{}, n = {}: shooting ({}), run {} of {} ...", c.label, c.chain.masses,
+                      orbits::shooting_solver_name(solver), r + 1, o.repeats));
+      const auto s0 = Clock::now();
+      orbits::StroboscopicMap map = make_map(c, kSteps);
+      setups.push_back(seconds_since(s0));
+      row.exact_tangent = map.exact_tangent();
+      const Stopwatch watch;
+      try {
+        const orbits::PeriodicOrbit orbit = orbits::find_periodic_orbit(map, guess, shooting);
+        times.push_back(watch.wall_seconds());
+        cpus.push_back(watch.cpu_seconds_since());
+        row.converged = true;
+        row.iterations = orbit.iterations;
+        row.evaluations = orbit.evaluations;
+        row.krylov_products = orbit.krylov_products;
+        row.preconditioned = orbit.preconditioned;
+        row.residual = orbit.residual;
+        row.radius = orbit.multipliers.largest_modulus();
+        row.multipliers = static_cast<int>(orbit.multipliers.values.size());
+        row.complete = orbit.multipliers.complete;
+        row.multipliers_converged = orbit.multipliers.converged;
+        row.arnoldi_residual = orbit.multipliers.residual;
+        row.stable = orbit.stable();
+        row.state = orbit.state;
+      } catch (const orbits::ShootingError& e) {
+        times.push_back(watch.wall_seconds());
+        cpus.push_back(watch.cpu_seconds_since());
+        row.converged = false;
+        row.failure = e.what();
+        row.iterations = e.iterations();
+        row.residual = e.residual();
+        break;  // it fails the same way every time
+      }
+    }
+    row.repeats = static_cast<int>(times.size());
+    row.setup = median(setups);
+    row.seconds = median(times);
+    row.cpu = median(cpus);
+    g.rows.push_back(std::move(row));
+  }
+
+  // The competitor: the same integrator from the same guess, period after period.
+  const ShootingRow* orbit = nullptr;
+  for (const ShootingRow& r : g.rows) {
+    if (r.converged) {
+      orbit = &r;
+      break;
+    }
+  }
+  BruteForce& b = g.brute;
+  b.ran = c.settle_budget > 0;
+  if (!b.ran) return;
+  std::vector<double> times, cpus;
+  for (int r = 0; r < o.repeats; ++r) {
+    say(fmt::format("{}, n = {}: brute force (at most {} periods), run {} of {} ...", c.label,
+                    c.chain.masses, c.settle_budget, r + 1, o.repeats));
+    orbits::StroboscopicMap map = make_map(c, kSteps);
+    Vector y = guess;
+    long k = 0;
+    double difference = 0.0, halfway = -1.0;
+    bool settled = false, diverged = false;
+    const Stopwatch watch;
+    try {
+      while (k < c.settle_budget) {
+        Vector next = map.advance(y, 1);
+        ++k;
+        difference = inf_norm(next - y);
+        y = std::move(next);
+        if (orbit != nullptr && k == c.settle_budget / 2) halfway = inf_norm(y - orbit->state);
+        if (!(difference == difference)) {  // NaN: the motion blew up
+          diverged = true;
+          break;
+        }
+        if (difference <= o.tolerance * std::max(1.0, inf_norm(y))) {
+          settled = true;
+          break;
+        }
+      }
+    } catch (const DivergenceError&) {
+      diverged = true;
+    }
+    times.push_back(watch.wall_seconds());
+    cpus.push_back(watch.cpu_seconds_since());
+    b.settled = settled;
+    b.diverged = diverged;
+    b.periods = k;
+    b.difference = difference;
+    b.distance = orbit != nullptr && !diverged ? inf_norm(y - orbit->state) : -1.0;
+    b.start_distance = orbit != nullptr ? inf_norm(guess - orbit->state) : -1.0;
+    b.halfway_distance = settled || diverged ? -1.0 : halfway;
+    if (diverged) break;
+  }
+  b.repeats = static_cast<int>(times.size());
+  b.seconds = median(times);
+  b.cpu = median(cpus);
+  // Not settled but approaching the orbit (the distance fell over each half of the budget): the
+  // periods still needed for the distance to reach the tolerance at the mean rate of the second
+  // half, a rough estimate. (The orbit's ρ is no guide: far from the orbit the springs touch
+  // differently, and the slowest decay is the open chain's.)
+  if (!b.settled && !b.diverged && b.distance > 0 && b.halfway_distance > 0 &&
+      b.halfway_distance < b.start_distance && b.distance < b.halfway_distance) {
+    const double target = o.tolerance * std::max(1.0, inf_norm(orbit->state));
+    const double half = static_cast<double>(b.periods - c.settle_budget / 2);
+    const double rate = std::log(b.distance / b.halfway_distance) / half;  // < 0, per period
+    if (b.distance > target) b.more_periods = std::log(target / b.distance) / rate;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// 2. Continuation.
+
+struct ContinuationCase {
+  std::string key;
+  std::string label;
+  NondimensionalChain chain;  // at the start value of θ
+  Method method = Method::exact;
+  double end = 3.0;
+};
+
+struct ContinuationRow {
+  std::string label;
+  int masses = 0;
+  std::string method;
+  bool exact_tangent = true;
+  int repeats = 0;
+  double start = 0.0, end = 0.0;  // the range asked
+  double lowest = 0.0, highest = 0.0, last = 0.0;  // θ reached
+  long points = 0;
+  double seconds = 0.0;  // median, s (the first point's Newton included; wall clock)
+  double cpu = 0.0;      // median CPU time, s
+  std::vector<orbits::Bifurcation> bifurcations;
+  std::vector<std::string> notes;
+  std::string failure;
+};
+
+std::string bifurcation_list(const ContinuationRow& r, std::size_t at_most) {
+  if (r.bifurcations.empty()) return "none";
+  std::map<std::string, int> counts;
+  for (const auto& b : r.bifurcations) ++counts[orbits::bifurcation_name(b.type)];
+  std::string text = fmt::format("{}:", r.bifurcations.size());
+  bool first = true;
+  for (const auto& [name, count] : counts) {
+    text += fmt::format("{} {} {}", first ? "" : ",", count, name);
+    first = false;
+  }
+  text += " (θ =";
+  for (std::size_t i = 0; i < r.bifurcations.size() && i < at_most; ++i) {
+    text += fmt::format("{} {:.4f}", i == 0 ? "" : ",", r.bifurcations[i].parameter);
+  }
+  if (r.bifurcations.size() > at_most) text += ", ...";
+  return text + ")";
+}
+
+ContinuationRow run_continuation(const ContinuationCase& c, const OrbitBenchOptions& o,
+                                 const std::function<void(const std::string&)>& say) {
+  ContinuationRow row;
+  row.label = c.label;
+  row.masses = c.chain.masses;
+  row.method = std::string(method_traits(c.method).name);
+  row.start = c.chain.theta;
+  row.end = c.end;
+  orbits::ContinuationOptions options;
+  options.parameter = analysis::SweepParameter::theta;
+  options.start = c.chain.theta;
+  options.end = c.end;
+  options.max_points = o.points;
+  options.method.method = c.method;
+  options.shooting.tolerance = o.tolerance;
+  const analysis::PointModel model(c.chain);
+  Vector guess;
+  {
+    orbits::StroboscopicMap map(model.point_case(), options.method, options.steps_per_period);
+    row.exact_tangent = map.exact_tangent();
+    guess = Vector::Zero(map.state_size());
+    if (o.transient > 0) guess = map.advance(guess, o.transient);
+  }
+  std::vector<double> times, cpus;
+  for (int r = 0; r < o.repeats; ++r) {
+    say(fmt::format("{}, n = {}: continuation of {} points, run {} of {} ...", c.label,
+                    c.chain.masses, o.points, r + 1, o.repeats));
+    const Stopwatch watch;
+    try {
+      const orbits::ContinuationResult result =
+          orbits::continue_periodic_orbit(model, guess, options);
+      times.push_back(watch.wall_seconds());
+      cpus.push_back(watch.cpu_seconds_since());
+      row.points = static_cast<long>(result.points.size());
+      row.bifurcations = result.bifurcations;
+      row.notes = result.notes;
+      if (!result.points.empty()) {
+        row.lowest = row.highest = result.points.front().parameter;
+        for (const auto& p : result.points) {
+          row.lowest = std::min(row.lowest, p.parameter);
+          row.highest = std::max(row.highest, p.parameter);
+        }
+        row.last = result.points.back().parameter;
+      }
+    } catch (const Error& e) {
+      row.failure = e.what();
+      break;
+    }
+  }
+  row.repeats = static_cast<int>(times.size());
+  row.seconds = median(times);
+  row.cpu = median(cpus);
+  return row;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Tables and files.
+
+std::string seconds_text(double wall, double cpu) { return fmt::format("{:.3g} ({:.3g})", wall, cpu); }
+
+std::string format_tables(const OrbitBenchOptions& o, const std::vector<ShootingGroup>& groups,
+                          const std::vector<ContinuationRow>& continuations) {
+  std::string t;
+  if (!groups.empty()) {
+    t += fmt::format(
+        "Periodic orbit and its Floquet multipliers from the state after {} periods from rest "
+        "(tolerance {:.0e}; times: medians of {} runs, wall clock with the CPU time of all threads in "
+        "parentheses):\n\n",
+        o.transient, o.tolerance, o.repeats);
+    t += "| case | n | method | solver | setup s | shooting s | Newton it. | map evals | GMRES "
+         "products | residual | ρ(M) | multipliers | stable | brute force (same integrator, same "
+         "guess) | brute force s | brute force / shooting |\n";
+    t += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const ShootingGroup& g : groups) {
+      for (const ShootingRow& r : g.rows) {
+        const std::string solver =
+            orbits::shooting_solver_name(r.solver) +
+            (r.solver == ShootingSolver::krylov && r.preconditioned ? " (preconditioned)" : "");
+        if (!r.converged) {
+          t += fmt::format("| {} | {} | {} | {} | {:.3g} | {} | {} | - | - | {:.1e} | - | - | "
+                           "- | {} | {} | - |\n",
+                           r.case_label, r.masses, method_text(r), solver, r.setup,
+                           seconds_text(r.seconds, r.cpu), r.iterations, r.residual,
+                           "Newton failed: " + r.failure + "; brute force: " + brute_text(g),
+                           g.brute.ran ? seconds_text(g.brute.seconds, g.brute.cpu) : "-");
+          continue;
+        }
+        const std::string multipliers =
+            r.complete ? fmt::format("all {}", r.multipliers)
+                       : fmt::format("leading {} (Arnoldi{})", r.multipliers,
+                                     r.multipliers_converged
+                                         ? ""
+                                         : fmt::format(", residual {:.1e}", r.arnoldi_residual));
+        t += fmt::format(
+            "| {} | {} | {} | {} | {:.3g} | {} | {} | {} | {} | {:.1e} | {} | {} | {} | {} | {} | "
+            "{} |\n",
+            r.case_label, r.masses, method_text(r), solver, r.setup, seconds_text(r.seconds, r.cpu),
+            r.iterations, r.evaluations,
+            r.solver == ShootingSolver::krylov ? fmt::format("{}", r.krylov_products) : "-",
+            r.residual,
+            r.multipliers_converged ? fmt::format("{:.6g}", r.radius)
+                                    : fmt::format("{:.6g} (not converged)", r.radius),
+            multipliers, stable_text(r), brute_text(g),
+            g.brute.ran ? seconds_text(g.brute.seconds, g.brute.cpu) : "-", ratio_text(g, r));
+      }
+    }
+    for (const ShootingGroup& g : groups) {
+      const ShootingRow* dense = nullptr;
+      const ShootingRow* krylov = nullptr;
+      for (const ShootingRow& r : g.rows) {
+        if (r.converged && r.solver == ShootingSolver::dense) dense = &r;
+        if (r.converged && r.solver == ShootingSolver::krylov) krylov = &r;
+      }
+      if (dense != nullptr && krylov != nullptr && krylov->seconds > 0) {
+        t += fmt::format(
+            "\n{}, n = {}: dense / Krylov shooting time = {:.3g} ({:.3g} s / {:.3g} s); the two "
+            "orbits differ by {:.1e}, their ρ(M) by {:.1e}.\n",
+            g.spec.label, g.spec.chain.masses, dense->seconds / krylov->seconds, dense->seconds,
+            krylov->seconds, inf_norm(dense->state - krylov->state),
+            std::abs(dense->radius - krylov->radius));
+      }
+      for (const ShootingRow& r : g.rows) {
+        if (!r.exact_tangent) {
+          t += fmt::format(
+              "\n{}, n = {}: {} has no exact tangent map here: its products are forward "
+              "differences (one extra integration per product).\n",
+              g.spec.label, g.spec.chain.masses, r.method);
+          break;
+        }
+      }
+    }
+  }
+  if (!continuations.empty()) {
+    t += fmt::format(
+        "\n\nPseudo-arclength continuation in θ of the period-1 orbit, at most {} points (times: "
+        "medians of {} runs, wall clock with the CPU time in parentheses):\n\n",
+        o.points, o.repeats);
+    t += "| case | n | method | θ asked | θ reached | points | bifurcations | total s | ms per "
+         "point | why it stopped |\n";
+    t += "|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const ContinuationRow& r : continuations) {
+      if (!r.failure.empty()) {
+        t += fmt::format("| {} | {} | {} | {:g} → {:g} | - | - | - | - | - | failed: {} |\n",
+                         r.label, r.masses, r.method, r.start, r.end, r.failure);
+        continue;
+      }
+      std::string notes;
+      for (const std::string& n : r.notes) notes += (notes.empty() ? "" : "; ") + n;
+      t += fmt::format("| {} | {} | {} ({} tangent) | {:g} → {:g} | {:.4f} ... {:.4f} | {} | {} | "
+                       "{} | {:.3g} | {} |\n",
+                       r.label, r.masses, r.method, r.exact_tangent ? "exact" : "finite-difference",
+                       r.start, r.end, r.lowest, r.highest, r.points, bifurcation_list(r, 8),
+                       seconds_text(r.seconds, r.cpu), r.points > 0 ? 1e3 * r.seconds / static_cast<double>(r.points) : 0.0,
+                       notes);
+    }
+  }
+  return t;
+}
+
+std::string csv_quoted(const std::string& text) {
+  std::string q = "\"";
+  for (char ch : text) {
+    if (ch == '"') q += '"';
+    q += ch;
+  }
+  return q + "\"";
+}
+
+void write_csv(const std::string& path, const std::vector<ShootingGroup>& groups,
+               const std::vector<ContinuationRow>& continuations) {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (f == nullptr) throw Error(fmt::format("cannot write {}", path));
+  fmt::print(f,
+             "section,case,n,method,exact_tangent,solver,repeats,setup_seconds,seconds,cpu_seconds,"
+             "converged,"
+             "iterations,evaluations,krylov_products,residual,spectral_radius,multipliers,"
+             "multipliers_converged,stable,brute_status,brute_periods,brute_difference,"
+             "brute_distance,brute_more_periods,brute_seconds,brute_cpu_seconds,brute_over_shooting,"
+             "theta_start,"
+             "theta_end,theta_lowest,theta_highest,points,bifurcations,seconds_per_point,"
+             "bifurcation_list\n");
+  for (const ShootingGroup& g : groups) {
+    const BruteForce& b = g.brute;
+    const std::string status = !b.ran ? "not-run" : b.diverged ? "diverged"
+                               : b.settled                   ? "settled"
+                                                             : "not-settled";
+    for (const ShootingRow& r : g.rows) {
+      // Empty where brute force cannot find the orbit (unstable) or blew up.
+      const bool comparable = b.ran && !b.diverged && r.converged && r.seconds > 0 &&
+                              !(r.multipliers_converged && !r.stable);
+      const std::string ratio = comparable ? fmt::format("{:.6g}", b.seconds / r.seconds) : "";
+      fmt::print(f,
+                 "shooting,{},{},{},{},{},{},{:.6g},{:.6g},{:.6g},{},{},{},{},{:.3e},{:.10g},{},{},{},"
+                 "{},{},{:.3e},{:.3e},{:.4g},{:.6g},{:.6g},{},,,,,,,,\n",
+                 csv_quoted(r.case_label), r.masses, r.method, r.exact_tangent ? 1 : 0,
+                 orbits::shooting_solver_name(r.solver), r.repeats, r.setup, r.seconds, r.cpu,
+                 r.converged ? 1 : 0, r.iterations, r.evaluations, r.krylov_products, r.residual,
+                 r.radius, r.multipliers, r.multipliers_converged ? 1 : 0,
+                 !r.converged ? "" : !r.multipliers_converged ? "undetermined" : r.stable ? "yes" : "no",
+                 status, b.periods, b.difference, b.distance, b.more_periods, b.seconds, b.cpu,
+                 ratio);
+    }
+  }
+  for (const ContinuationRow& r : continuations) {
+    std::string list;
+    for (const auto& bif : r.bifurcations) {
+      list += fmt::format("{}{} {:.10g}", list.empty() ? "" : "; ",
+                          orbits::bifurcation_name(bif.type), bif.parameter);
+    }
+    fmt::print(f,
+               "continuation,{},{},{},{},dense,{},,{:.6g},{:.6g},{},,,,,,,,,,,,,,,,,{:.10g},{:.10g},"
+               "{:.10g},{:.10g},{},{},{:.6g},{}\n",
+               csv_quoted(r.label), r.masses, r.method, r.exact_tangent ? 1 : 0, r.repeats,
+               r.seconds, r.cpu, r.failure.empty() ? 1 : 0, r.start, r.end, r.lowest, r.highest,
+               r.points, r.bifurcations.size(),
+               r.points > 0 ? r.seconds / static_cast<double>(r.points) : 0.0, csv_quoted(list));
+  }
+  std::fclose(f);
+}
+
+bool wanted(const OrbitBenchOptions& o, const std::string& key) {
+  return o.cases.empty() || std::find(o.cases.begin(), o.cases.end(), key) != o.cases.end();
+}
+
+void run(OrbitBenchOptions o, bool repeats_given) {
+  for (const std::string& key : o.cases) {
+    if (std::find(case_keys().begin(), case_keys().end(), key) == case_keys().end()) {
+      throw InputError(fmt::format("--cases: {} is not a case; use {}", key,
+                                   fmt::join(case_keys(), ", ")));
+    }
+  }
+  if (o.settle_periods.size() != 3) {
+    throw InputError(fmt::format(
+        "--settle-periods: expected 3 budgets (5-DOF, medium, large chain), got {}",
+        o.settle_periods.size()));
+  }
+  if (o.sizes.size() != 2) {
+    throw InputError(fmt::format("--sizes: expected 2 sizes (medium, large chain), got {}",
+                                 o.sizes.size()));
+  }
+  if (o.quick) {  // a smoke run: smaller chains, budgets and branches
+    o.sizes = {std::min(o.sizes[0], 10), std::min(o.sizes[1], 100)};
+    o.settle_periods = {std::min<long>(o.settle_periods[0], 2000),
+                        std::min<long>(o.settle_periods[1], 2000),
+                        std::min<long>(o.settle_periods[2], 100)};
+    o.points = std::min(o.points, 20);
+    if (!repeats_given) o.repeats = 1;
+  }
+  const auto say = [&](const std::string& text) {
+    if (!o.quiet) fmt::print(stderr, "{}\n", text);
+  };
+
+  std::vector<ShootingCase> cases;
+  if (wanted(o, "4a")) {
+    cases.push_back({"4a", "figure 4a (θ = 1)", fig4a_chain(5, 1.0), Method::exact,
+                     {ShootingSolver::dense}, o.settle_periods[0]});
+  }
+  if (wanted(o, "4a-stable")) {
+    cases.push_back({"4a-stable", "figure 4a chain, θ = 1.2", fig4a_chain(5, 1.2), Method::exact,
+                     {ShootingSolver::dense}, o.settle_periods[0]});
+  }
+  if (wanted(o, "medium")) {
+    cases.push_back({"medium", "figure 4a chain, θ = 1.5", fig4a_chain(o.sizes[0], 1.5),
+                     Method::pim_switching, {ShootingSolver::dense, ShootingSolver::krylov},
+                     o.settle_periods[1]});
+  }
+  if (wanted(o, "large")) {
+    cases.push_back({"large", "figure 4a chain, θ = 1.5", fig4a_chain(o.sizes[1], 1.5),
+                     Method::pim_switching_banded, {ShootingSolver::krylov}, o.settle_periods[2]});
+  }
+  std::vector<ShootingGroup> groups;
+  for (const ShootingCase& c : cases) {
+    ShootingGroup g;
+    g.spec = c;
+    run_shooting(g, o, say);
+    groups.push_back(std::move(g));
+  }
+
+  std::vector<ContinuationRow> continuations;
+  if (wanted(o, "continue-5")) {
+    continuations.push_back(run_continuation(
+        {"continue-5", "figure 4a chain", fig4a_chain(5, 1.2), Method::exact, 3.0}, o, say));
+  }
+  if (wanted(o, "continue-medium")) {
+    continuations.push_back(run_continuation({"continue-medium", "figure 4a chain",
+                                              fig4a_chain(o.sizes[0], 1.0), Method::pim_switching,
+                                              3.0},
+                                             o, say));
+  }
+
+  const std::string table = format_tables(o, groups, continuations);
+  fmt::print("{}", table);
+  std::filesystem::create_directories(o.out);
+  write_csv(o.out + "/bench_orbits.csv", groups, continuations);
+  if (std::FILE* f = std::fopen((o.out + "/bench_orbits.md").c_str(), "w")) {
+    fmt::print(f, "{}", table);
+    std::fclose(f);
+  }
+  fmt::print("\nwrote {0}/bench_orbits.csv and {0}/bench_orbits.md\n", o.out);
+}
+
+}  // namespace
+
+void add_orbits_bench(CLI::App& bench) {
+  auto o = std::make_shared<OrbitBenchOptions>();
+  CLI::App* c = bench.add_subcommand(
+      "orbits",
+      "Periodic orbits by shooting against brute-force settling (n = 5, 100, 1000; dense and\n"
+      "Newton-Krylov), and 200-point continuations in θ with their bifurcations\n"
+      "Example: pwl bench orbits --out out/bench\n"
+      "         pwl bench orbits --cases large --repeats 1   (only the 1000-mass chain)");
+  c->add_option("--repeats", o->repeats, "Timed runs per measurement (median)")
+      ->check(positive_number());
+  c->add_flag("--quick", o->quick,
+              "A smoke run: chains of 10 and 100 masses, small budgets, 20-point branches, one run "
+              "unless --repeats");
+  c->add_option("--transient", o->transient, "Periods from rest to the common guess")
+      ->check(non_negative_number());
+  c->add_option("--tol", o->tolerance, "Tolerance of shooting and of brute-force settling")
+      ->check(positive_number());
+  c->add_option("--settle-periods", o->settle_periods,
+                "Brute-force budgets in periods: 5-DOF, medium chain, large chain (0: no brute "
+                "force)")
+      ->delimiter(',')
+      ->check(non_negative_number());
+  c->add_option("--sizes", o->sizes, "Masses of the medium and the large chain")
+      ->delimiter(',')
+      ->check(CLI::Range(2, 1000000));
+  c->add_option("--points", o->points, "Continuation points per branch")->check(CLI::Range(2, 100000));
+  c->add_option("--cases", o->cases,
+                "Only these: 4a, 4a-stable, medium, large, continue-5, continue-medium")
+      ->delimiter(',');
+  c->add_option("--out", o->out, "Folder for bench_orbits.csv and bench_orbits.md");
+  c->add_flag("--quiet", o->quiet, "Print only the tables");
+  c->callback([o, c] { run(*o, c->count("--repeats") > 0); });
+}
+
+}  // namespace pwl::app
