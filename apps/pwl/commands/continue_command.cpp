@@ -459,12 +459,7 @@ void continue_orbit(const ContinueFlags& f) {
   Vector guess;
   {
     orbits::StroboscopicMap map(first_case, method.settings, method.steps_per_period);
-    if (!map.exact_tangent()) {
-      fmt::print("note: {} has no exact tangent map: every monodromy comes from forward "
-                 "differences of the flow (2n integrations), and the multipliers are accurate to "
-                 "about eight digits\n",
-                 method_label(method.settings));
-    }
+    note_when_no_tangent_map(map);
     guess = starting_guess(o, map);
   }
   std::string title = fmt::format(

@@ -83,12 +83,7 @@ void orbit(const OrbitCommandFlags& f) {
   if (!shooting.is_valid(&why)) throw InputError(why);
 
   orbits::StroboscopicMap map(point, method.settings, method.steps_per_period);
-  if (!map.exact_tangent()) {
-    fmt::print("note: {} has no exact tangent map: the Jacobian comes from forward differences of "
-               "the flow (one integration per column), and the multipliers are accurate to about "
-               "eight digits\n",
-               method_label(method.settings));
-  }
+  note_when_no_tangent_map(map);
   const Vector guess = starting_guess(o, map);
   const orbits::PeriodicOrbit orbit = orbits::find_periodic_orbit(map, guess, shooting);
 

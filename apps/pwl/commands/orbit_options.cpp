@@ -142,6 +142,14 @@ Vector read_state_file(const std::string& flag, const std::string& path, Index d
   return y;
 }
 
+void note_when_no_tangent_map(const orbits::StroboscopicMap& map) {
+  if (map.exact_tangent()) return;
+  fmt::print("note: {} has no exact tangent map: every monodromy comes from forward differences "
+             "of the flow (one integration per column), and the multipliers are accurate to about "
+             "eight digits\n",
+             method_label(map.settings()));
+}
+
 Vector starting_guess(const OrbitFlags& f, orbits::StroboscopicMap& map) {
   if (!f.guess_file.empty()) return read_state_file("--guess-file", f.guess_file, map.dofs());
   const Vector rest = Vector::Zero(map.state_size());

@@ -49,6 +49,11 @@ OrbitMethod orbit_method(const OrbitFlags& flags, const GapStructure& structure,
 // InputError naming `flag`, the file and what is wrong.
 Vector read_state_file(const std::string& flag, const std::string& path, Index dofs);
 
+// Prints a note when `map`'s method has no exact tangent map (its monodromy then comes from forward
+// differences of the flow, one integration per column, and its multipliers are accurate to about
+// eight digits).
+void note_when_no_tangent_map(const orbits::StroboscopicMap& map);
+
 // The starting guess: the state in --guess-file, or the state --transient forcing periods after
 // rest, by `map` (its structure is the case the guess is for).
 Vector starting_guess(const OrbitFlags& flags, orbits::StroboscopicMap& map);

@@ -317,33 +317,12 @@ class Stepper final
   }
 
   void advance_to(double t_end, const StepObserver& observer) override {
-    detail::advance_on_grid(
-        t_end, time(), eta_, observer, position_, velocity_,
-        [this] {
-          step();
-          return time();
-        },
-        [this] { sync(); });
+    this->advance_steps(t_end, nullptr, observer);
   }
 
   // advance_to, and the tangent map of every step applied to `tangent` (see switching_pim.hpp).
   void advance_with_tangent(double t_end, Matrix& tangent, const StepObserver& observer) override {
-    if (tangent.rows() != 2 * n_) {
-      throw InputError(fmt::format("tangent has {} rows; the state [x; x'] has {}", tangent.rows(),
-                                   2 * n_));
-    }
-    this->tangent_ = &tangent;
-    struct Release {
-      Stepper* s;
-      ~Release() { s->tangent_ = nullptr; }
-    } release{this};
-    detail::advance_on_grid(
-        t_end, time(), eta_, observer, position_, velocity_,
-        [this] {
-          step_with_tangent();
-          return time();
-        },
-        [this] { sync(); });
+    this->advance_steps(t_end, &tangent, observer);
   }
 
  private:

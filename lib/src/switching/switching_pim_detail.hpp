@@ -10,6 +10,8 @@
 #include <fmt/format.h>
 
 #include "event/event_location.hpp"
+#include "integrators/fixed_step_count.hpp"
+#include "pwl/integrators/integrator.hpp"
 #include "pwl/errors.hpp"
 #include "pwl/types.hpp"
 
@@ -167,6 +169,33 @@ class ModeSeries {
  protected:
   Stepper& self() { return static_cast<Stepper&>(*this); }
   const Stepper& self() const { return static_cast<const Stepper&>(*this); }
+
+  // The grid driver of both steppers' advance_to and advance_with_tangent: every step to t_end,
+  // and with `tangent` (2n x p, rows [x; x']) the tangent map of each step applied to it
+  // (step_with_tangent; tangent_ points to it for the duration).
+  void advance_steps(double t_end, Matrix* tangent, const StepObserver& observer) {
+    Stepper& st = self();
+    if (tangent != nullptr && tangent->rows() != 2 * st.n_) {
+      throw InputError(fmt::format("tangent has {} rows; the state [x; x'] has {}",
+                                   tangent->rows(), 2 * st.n_));
+    }
+    tangent_ = tangent;
+    struct Release {
+      Matrix*& tangent;
+      ~Release() { tangent = nullptr; }
+    } release{tangent_};
+    detail::advance_on_grid(
+        t_end, st.time(), st.eta_, observer, st.position_, st.velocity_,
+        [&st, tangent] {
+          if (tangent != nullptr) {
+            st.step_with_tangent();
+          } else {
+            st.step();
+          }
+          return st.time();
+        },
+        [&st] { st.sync(); });
+  }
 
   // Sizes the series buffers for `terms` terms, n degrees of freedom and m springs.
   void size_series(std::size_t terms, Index n, Index m) {
