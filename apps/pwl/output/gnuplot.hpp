@@ -1,7 +1,9 @@
 #pragma once
-// Runs the shipped gnuplot scripts. Figures are a by-product: a machine without gnuplot still gets
-// its CSV files, and a warning instead of a failure. Every figure is drawn twice, as PNG and SVG,
-// through plots/scripts/terminal.gp, so that both look alike.
+// Runs the shipped gnuplot scripts (plots/scripts/*.gp) through a gnuplot-iostream session: the
+// variables a figure needs are streamed to gnuplot, then the script is loaded, so the scripts stay
+// plain files that a user edits and runs by hand. Figures are a by-product: a machine without
+// gnuplot still gets its CSV files, and a warning instead of a failure. Every figure is drawn
+// twice, as PNG and SVG, through plots/scripts/terminal.gp, so that both look alike.
 #include <functional>
 #include <string>
 
