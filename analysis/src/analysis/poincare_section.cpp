@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 
 #include "pwl/errors.hpp"
@@ -143,7 +144,41 @@ Vector hermite_vector_rate(const Vector& y0, const Vector& dy0, const Vector& y1
          ((-6 * s2 + 6 * s) / step) * y1 + (3 * s2 - 2 * s) * dy1;
 }
 
+// The Hermite interpolation of interpolate_state, without its checks (a.t < t < b.t).
+StateSample hermite_state(const StateSample& a, const StateSample& b, double t) {
+  const double step = b.t - a.t;
+  const double s = (t - a.t) / step;
+  StateSample out;
+  out.t = t;
+  out.x = hermite_vector(a.x, a.v, b.x, b.v, step, s);
+  if (a.a.size() != 0 && b.a.size() != 0) {
+    out.v = hermite_vector(a.v, a.a, b.v, b.a, step, s);
+    out.a = (1.0 - s) * a.a + s * b.a;
+  } else {
+    out.v = hermite_vector_rate(a.x, a.v, b.x, b.v, step, s);
+  }
+  return out;
+}
+
 }  // namespace
+
+StateSample interpolate_state(const StateSample& a, const StateSample& b, double t) {
+  if (a.v.size() != a.x.size() || b.x.size() != a.x.size() || b.v.size() != a.x.size() ||
+      (a.a.size() != 0 && a.a.size() != a.x.size()) ||
+      (b.a.size() != 0 && b.a.size() != a.x.size())) {
+    throw InputError(fmt::format("interpolate_state: samples of different sizes (x {} and {}, v {} "
+                                 "and {}, a {} and {})",
+                                 a.x.size(), b.x.size(), a.v.size(), b.v.size(), a.a.size(),
+                                 b.a.size()));
+  }
+  if (!(a.t <= t && t <= b.t) || !(a.t < b.t) || !std::isfinite(t)) {
+    throw InputError(fmt::format("interpolate_state: t = {} is not within the samples' [{}, {}]",
+                                 t, a.t, b.t));
+  }
+  if (t == a.t) return a;
+  if (t == b.t) return b;
+  return hermite_state(a, b, t);
+}
 
 bool HyperplaneSection::is_valid(std::string* why) const {
   if (component < 0) {
@@ -237,6 +272,114 @@ std::vector<Crossing> find_crossings(const HyperplaneSection& section,
   return crossings;
 }
 
+bool PoincareSection::is_valid(Index dofs, std::string* why) const {
+  if (!(phase >= 0.0 && phase < 1.0)) {
+    return fail(why, fmt::format("PoincareSection.phase = {} must be a fraction of the forcing "
+                                 "period, 0 <= phase < 1",
+                                 phase));
+  }
+  if (stroboscopic()) return true;
+  if (!hyperplane.is_valid(why)) return false;
+  if (hyperplane.component >= 2 * dofs) {
+    return fail(why, fmt::format("HyperplaneSection.component = {} is out of range for a state of "
+                                 "{} components",
+                                 hyperplane.component, 2 * dofs));
+  }
+  return true;
+}
+
+namespace {
+
+std::string component_text(Index component, Index dofs) {
+  return component < dofs ? fmt::format("x{}", component + 1)
+                          : fmt::format("v{}", component - dofs + 1);
+}
+
+const char* direction_text(CrossingDirection direction) {
+  switch (direction) {
+    case CrossingDirection::up: return "up";
+    case CrossingDirection::down: return "down";
+    case CrossingDirection::both: return "both";
+  }
+  return "both";
+}
+
+std::string_view trimmed(std::string_view text) {
+  while (!text.empty() && (text.front() == ' ' || text.front() == '\t')) text.remove_prefix(1);
+  while (!text.empty() && (text.back() == ' ' || text.back() == '\t')) text.remove_suffix(1);
+  return text;
+}
+
+}  // namespace
+
+std::string PoincareSection::text(Index dofs) const {
+  if (stroboscopic()) return "strobe";
+  return fmt::format("{}={},{}", component_text(hyperplane.component, dofs), hyperplane.level,
+                     direction_text(hyperplane.direction));
+}
+
+std::string PoincareSection::label(Index dofs) const {
+  if (stroboscopic()) return phase == 0.0 ? "t = kT" : fmt::format("t = (k + {})T", phase);
+  const char* going = hyperplane.direction == CrossingDirection::up     ? " going up"
+                      : hyperplane.direction == CrossingDirection::down ? " going down"
+                                                                         : "";
+  return fmt::format("{} = {}{}", component_text(hyperplane.component, dofs), hyperplane.level,
+                     going);
+}
+
+PoincareSection parse_poincare_section(std::string_view text, Index dofs) {
+  const std::string_view whole = trimmed(text);
+  PoincareSection section;
+  if (whole == "strobe") return section;
+  const std::string form = fmt::format(
+      "give strobe, or a hyperplane as <x|v><mass>=<level>,<up|down|both> (e.g. v3=0,down) with "
+      "mass 1..{}",
+      dofs);
+  const std::size_t equals = whole.find('=');
+  const std::size_t comma = whole.find(',');
+  if (equals == std::string_view::npos || comma == std::string_view::npos || comma < equals ||
+      whole.find(',', comma + 1) != std::string_view::npos) {
+    throw InputError(form);
+  }
+  const std::string_view name = trimmed(whole.substr(0, equals));
+  const std::string level(trimmed(whole.substr(equals + 1, comma - equals - 1)));
+  const std::string_view direction = trimmed(whole.substr(comma + 1));
+  // The component: x or v and a whole number.
+  long mass = 0;
+  bool named = name.size() >= 2 && (name[0] == 'x' || name[0] == 'v');
+  for (std::size_t i = 1; named && i < name.size(); ++i) {
+    named = name[i] >= '0' && name[i] <= '9' && (i > 1 || name[i] != '0') && mass < 1000000000L;
+    if (named) mass = 10 * mass + (name[i] - '0');
+  }
+  if (!named) throw InputError(fmt::format("'{}' is not a state component; {}", name, form));
+  if (mass < 1 || mass > dofs) {
+    throw InputError(fmt::format("{} names no state component of this structure: it has {} "
+                                 "mass{} (x1..x{}, v1..v{})",
+                                 name, dofs, dofs == 1 ? "" : "es", dofs, dofs));
+  }
+  char* end = nullptr;
+  const double value = std::strtod(level.c_str(), &end);
+  if (level.empty() || end != level.c_str() + level.size()) {
+    throw InputError(fmt::format("the level '{}' is not a number; {}", level, form));
+  }
+  if (!std::isfinite(value)) {
+    throw InputError(fmt::format("the level {} is not finite", level));
+  }
+  section.kind = PoincareSection::Kind::hyperplane;
+  section.hyperplane.component = (name[0] == 'x' ? 0 : dofs) + (mass - 1);
+  section.hyperplane.level = value;
+  if (direction == "up") {
+    section.hyperplane.direction = CrossingDirection::up;
+  } else if (direction == "down") {
+    section.hyperplane.direction = CrossingDirection::down;
+  } else if (direction == "both") {
+    section.hyperplane.direction = CrossingDirection::both;
+  } else {
+    throw InputError(fmt::format("the direction '{}' is not up, down or both", direction));
+  }
+  return section;
+}
+
 bool StroboscopicOptions::is_valid(std::string* why) const {
   if (!(snap_tolerance >= 0.0) || !(snap_tolerance < 0.5)) {
     return fail(why, fmt::format("StroboscopicOptions.snap_tolerance = {} must be in [0, 0.5)",
@@ -300,15 +443,7 @@ void StroboscopicSampler::observe(double t, const Vector& x, const Vector& v, co
     } else if (std::abs(tk - t) <= snap) {
       out = current;
     } else {
-      const double s = (tk - p.t) / step;
-      out.x = hermite_vector(p.x, p.v, current.x, current.v, step, s);
-      const bool accelerations = p.a.size() != 0 && current.a.size() != 0;
-      if (accelerations) {
-        out.v = hermite_vector(p.v, p.a, current.v, current.a, step, s);
-        out.a = (1.0 - s) * p.a + s * current.a;
-      } else {
-        out.v = hermite_vector_rate(p.x, p.v, current.x, current.v, step, s);
-      }
+      out = hermite_state(p, current, tk);
     }
     out.t = tk;
     samples_.push_back(std::move(out));

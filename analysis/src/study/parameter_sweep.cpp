@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "pwl/errors.hpp"
 #include "pwl/study/indicators.hpp"
@@ -137,7 +138,9 @@ void write_sweep_files(const SweepOptions& o, const std::map<long, PointResult>&
   }
   const std::string name = parameter_name(o.parameter);
   const int dofs = o.model().dofs();
-  fmt::print(poincare, "{},direction,index,period_index", name);
+  // A stroboscopic point is numbered by its period; a hyperplane's crossing by its time.
+  const bool crossings = !o.point.section.stroboscopic();
+  fmt::print(poincare, "{},direction,index,{}", name, crossings ? "t" : "period_index");
   for (int c : o.point.components) fmt::print(poincare, ",{}", component_name(c, dofs));
   fmt::print(poincare, "\n");
   fmt::print(classes, "index,{},direction,{}\n", name, indicator_header());
@@ -149,8 +152,15 @@ void write_sweep_files(const SweepOptions& o, const std::map<long, PointResult>&
     fmt::print(classes, "{},{:.17g},{},{}\n", index, value, direction, indicator_cells(r));
     const int rows = r.rows();
     for (int k = 0; k < rows; ++k) {
-      fmt::print(poincare, "{:.17g},{},{},{}", value, direction, index,
-                 o.point.transient_periods + k + 1);
+      if (crossings) {
+        fmt::print(poincare, "{:.17g},{},{},{:.17g}", value, direction, index,
+                   static_cast<std::size_t>(k) < r.section_times.size()
+                       ? r.section_times[static_cast<std::size_t>(k)]
+                       : std::numeric_limits<double>::quiet_NaN());
+      } else {
+        fmt::print(poincare, "{:.17g},{},{},{}", value, direction, index,
+                   o.point.transient_periods + k + 1);
+      }
       for (int c = 0; c < r.columns; ++c) {
         fmt::print(poincare, ",{:.17g}",
                    r.poincare[static_cast<std::size_t>(k) * static_cast<std::size_t>(r.columns) +

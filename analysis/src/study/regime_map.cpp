@@ -44,6 +44,12 @@ PointModel RegimeMapOptions::model() const {
 bool RegimeMapOptions::is_valid(std::string* why) const {
   std::string scratch;
   if (why == nullptr) why = &scratch;
+  if (!point.section.stroboscopic()) {
+    *why = "section: a regime map keeps no Poincaré points, only each cell's indicators, which are "
+           "classified on the stroboscopic map whatever the section; give the strobe (at any "
+           "phase)";
+    return false;
+  }
   if (first.parameter == second.parameter) {
     *why = fmt::format("both axes vary {}: give two different parameters",
                        parameter_name(first.parameter));

@@ -80,6 +80,12 @@ std::string encode_record(long id, const PointResult& r) {
   for (double v : r.poincare) put(payload, v);
   fmt::format_to(std::back_inserter(payload), " {}", r.final_state.size());
   for (Index i = 0; i < r.final_state.size(); ++i) put(payload, r.final_state[i]);
+  // The times of a hyperplane section's points, only when there are any: a stroboscopic point's
+  // line reads as it did before sections were chosen.
+  if (!r.section_times.empty()) {
+    fmt::format_to(std::back_inserter(payload), " {}", r.section_times.size());
+    for (double t : r.section_times) put(payload, t);
+  }
   return fmt::format("{} {:016x} {}\n", id, fnv1a(payload), payload);
 }
 
@@ -116,6 +122,15 @@ std::optional<std::pair<long, PointResult>> decode_record(std::string_view line)
   r.final_state.resize(state);
   for (Index i = 0; i < state; ++i)
     if (!t.number(&r.final_state[i])) return std::nullopt;
+  if (!t.done()) {
+    long times = 0;
+    if (!t.integer(&times) || times < 1 || (columns > 0 && times != count / columns)) {
+      return std::nullopt;
+    }
+    r.section_times.resize(static_cast<std::size_t>(times));
+    for (double& v : r.section_times)
+      if (!t.number(&v)) return std::nullopt;
+  }
   if (!t.done()) return std::nullopt;
   return std::make_pair(id, std::move(r));
 }

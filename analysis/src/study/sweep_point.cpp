@@ -11,6 +11,7 @@
 #include "pwl/analysis/zero_one_test.hpp"
 #include "pwl/errors.hpp"
 #include "pwl/integrators/method_table.hpp"
+#include "pwl/study/section_sampler.hpp"
 
 namespace pwl::analysis {
 
@@ -75,6 +76,7 @@ bool PointSettings::is_valid(int dofs, std::string* why) const {
                        row.name);
     return false;
   }
+  if (!section.is_valid(dofs, why)) return false;
   if (method.banded_above < 0) {
     *why = fmt::format("banded_above = {} must be >= 0", method.banded_above);
     return false;
@@ -91,6 +93,17 @@ std::string PointSettings::describe() const {
       observable, lyapunov, lyapunov_estimate_name(lyapunov_estimate), method_label(method));
   if (row.lcp) s += fmt::format("lcp = {}\n", lcp_algorithm_name(method.lcp));
   if (row.chooses_form) s += fmt::format("banded_above = {}\n", method.banded_above);
+  // Only a section other than the default is stated (see the header). The hyperplane's component
+  // is 0-based here: the description knows no number of masses.
+  if (!section.stroboscopic()) {
+    const char* direction = section.hyperplane.direction == CrossingDirection::up     ? "up"
+                            : section.hyperplane.direction == CrossingDirection::down ? "down"
+                                                                                       : "both";
+    s += fmt::format("section = hyperplane\nsection_component = {}\nsection_level = {:.17g}\n"
+                     "section_direction = {}\n",
+                     section.hyperplane.component, section.hyperplane.level, direction);
+  }
+  if (section.phase != 0.0) s += fmt::format("phase = {:.17g}\n", section.phase);
   return s;
 }
 
@@ -132,17 +145,19 @@ Averaging averaging(long count, int recorded) {
   return a;
 }
 
-// λ1 by two nearby trajectories of the period map from the first recorded point (the loads are
-// T-periodic, so every period starts at t = 0). A blow-up of the companion leaves λ1 unknown.
-void two_trajectory_lyapunov(const PointCase& point, const MethodSettings& method,
+// λ1 by two nearby trajectories of the period map from the first recorded point. The loads are
+// T-periodic, so every period starts at t = phase T (t = 0 at phase 0). A blow-up of the companion
+// leaves λ1 unknown.
+void two_trajectory_lyapunov(const PointCase& point, const MethodSettings& method, double phase,
                              const std::vector<Vector>& points, int recorded, PointResult& result) {
   const Averaging a = averaging(recorded, recorded);
   if (!a.enough() || points.empty()) return;
   const Index n = point.structure.dofs();
   auto shadow = make_integrator(point.structure, method);
+  const double start = phase * point.period;
   const StateMap map = [&](const Vector& s) {
-    shadow->set_state(0.0, s.head(n), s.tail(n));
-    shadow->advance_to(point.period);
+    shadow->set_state(start, s.head(n), s.tail(n));
+    shadow->advance_to(start + point.period);
     Vector image(2 * n);
     image << shadow->position(), shadow->velocity();
     return image;
@@ -179,12 +194,16 @@ PointResult evaluate_point(const PointCase& point, const Vector& initial_state,
   const MethodSettings method = s.method_for(period);
   std::unique_ptr<Integrator> integrator = make_integrator(structure, method);
   integrator->set_state(0.0, initial_state.head(n), initial_state.tail(n));
+  SectionSampler sampler(*integrator, structure, period, s.section, method, s.steps_per_period);
   if (observer != nullptr) observer->started(*integrator, point);
   const auto steps_of = [&](int k) { return observer ? observer->steps_of_period(k) : nullptr; };
 
   PointResult result;
   result.columns = static_cast<int>(s.components.size());
-  result.poincare.reserve(static_cast<std::size_t>(s.recorded_periods) * s.components.size());
+  const bool hyperplane = !s.section.stroboscopic();
+  if (!hyperplane) {
+    result.poincare.reserve(static_cast<std::size_t>(s.recorded_periods) * s.components.size());
+  }
   std::vector<Vector> points;
   points.reserve(static_cast<std::size_t>(s.recorded_periods));
   // What the integrator can do decides which estimates are possible, never its name.
@@ -195,36 +214,68 @@ PointResult evaluate_point(const PointCase& point, const Vector& initial_state,
   Matrix tangent_vector = initial_tangent(2 * n);
   // Per period: |J y| of the renormalised vector as a 1x1 Jacobian, or the whole Jacobian J.
   std::vector<Matrix> jacobians;
+  const int total = s.transient_periods + s.recorded_periods;
+  // A hyperplane's crossings are kept within the recorded periods, (t_first, t_last]: from the
+  // end of the transient (the start when there is none) to the last stroboscopic time. The search
+  // starts one period early, so that a grid point past the transient's last strobe time (an
+  // interpolated phase) loses nothing.
+  const double first_time =
+      s.transient_periods == 0 ? 0.0 : sampler.strobe_time(s.transient_periods);
+  const double last_time = sampler.strobe_time(total);
+  int period_now = 0;  // the period being integrated
+  const auto record_crossing = [&](const Crossing& c) {
+    if (!(c.t > first_time) || c.t > last_time) return;
+    const int k = c.t > sampler.strobe_time(period_now) ? period_now + 1 : period_now;
+    for (int component : s.components) result.poincare.push_back(c.state[component]);
+    result.section_times.push_back(c.t);
+    if (observer != nullptr) observer->poincare_point(k, c.t, c.state);
+  };
   try {
-    for (int k = 1; k <= s.transient_periods; ++k) integrator->advance_to(k * period, steps_of(k));
-    const int total = s.transient_periods + s.recorded_periods;
+    for (int k = 1; k <= s.transient_periods; ++k) {
+      period_now = k;
+      if (hyperplane && k == s.transient_periods) sampler.record_crossings(record_crossing);
+      sampler.advance_to_strobe(k, nullptr, steps_of(k));
+    }
+    if (hyperplane && s.transient_periods == 0) sampler.record_crossings(record_crossing);
     for (int k = s.transient_periods + 1; k <= total; ++k) {
+      period_now = k;
+      StrobePoint strobe;
       if (frame) {
         Matrix jacobian = Matrix::Identity(2 * n, 2 * n);
-        integrator->advance_with_tangent(k * period, jacobian, steps_of(k));
+        strobe = sampler.advance_to_strobe(k, &jacobian, steps_of(k));
         jacobians.push_back(std::move(jacobian));
       } else if (tangent) {
-        integrator->advance_with_tangent(k * period, tangent_vector, steps_of(k));
+        strobe = sampler.advance_to_strobe(k, &tangent_vector, steps_of(k));
         const double norm = tangent_vector.norm();
         jacobians.push_back(Matrix::Constant(1, 1, norm));
         if (norm > 0.0 && std::isfinite(norm)) tangent_vector /= norm;
       } else {
-        integrator->advance_to(k * period, steps_of(k));
+        strobe = sampler.advance_to_strobe(k, nullptr, steps_of(k));
       }
-      Vector state(2 * n);
-      state << integrator->position(), integrator->velocity();
-      for (int c : s.components) result.poincare.push_back(state[c]);
-      if (observer != nullptr) observer->poincare_point(k, integrator->time(), state);
-      points.push_back(std::move(state));
+      if (!hyperplane) {
+        for (int c : s.components) result.poincare.push_back(strobe.state[c]);
+        if (observer != nullptr) observer->poincare_point(k, strobe.t, strobe.state);
+      }
+      points.push_back(std::move(strobe.state));
+    }
+    if (hyperplane) sampler.record_crossings(nullptr);
+    if (s.section.phase == 0.0) {
+      result.final_state = points.back();
+    } else {
+      // On to the next whole period, where the loads are at phase 0 again.
+      sampler.advance_to(static_cast<double>(total + 1) * period);
+      result.final_state.resize(2 * n);
+      result.final_state << integrator->position(), integrator->velocity();
     }
   } catch (const DivergenceError&) {
     result.regime = "unbounded";
+    result.final_state.resize(0);
     return result;
   } catch (const LcpError&) {
     result.regime = "failed";
+    result.final_state.resize(0);
     return result;
   }
-  result.final_state = points.back();
 
   MotionEvidence evidence;
   if (tangent) {
@@ -240,7 +291,7 @@ PointResult evaluate_point(const PointCase& point, const Vector& initial_state,
       result.lambda1_error = spectrum.error[0];
     }
   } else if (lyapunov && s.lyapunov_estimate == LyapunovEstimate::two_trajectories) {
-    two_trajectory_lyapunov(point, method, points, s.recorded_periods, result);
+    two_trajectory_lyapunov(point, method, s.section.phase, points, s.recorded_periods, result);
   }
   if (std::isfinite(result.lambda1) && std::isfinite(result.lambda1_error)) {
     evidence.lyapunov = result.lambda1;

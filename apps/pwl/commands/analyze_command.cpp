@@ -2,11 +2,13 @@
 // Poincaré points, with the evidence used: the period search, λ1 and the 0-1 test.
 //
 // The motion is evaluated by the study pipeline (evaluate_point, pwl/study/sweep_point.hpp), the
-// same that classifies every point of `pwl sweep` and `pwl map`; analyze only adds its outputs
-// through the pipeline's observer: trajectory.csv (the steps of the last 20 periods of the chosen
-// mass), poincare.csv (the full state at every recorded period), classification.csv, the figure
-// and the printout. With the same settings a one-point sweep gives the same regime, period, λ1 and
-// K.
+// same that classifies every point of `pwl sweep` and `pwl map`, in analyze_case
+// (analyze_command.hpp); the command line only adds its outputs through the pipeline's observer:
+// trajectory.csv (the steps of the last 20 periods of the chosen mass), poincare.csv (the full
+// state at every recorded point of the section), classification.csv, the figure and the printout.
+// With the same settings a one-point sweep gives the same regime, period, λ1 and K.
+#include "commands/analyze_command.hpp"
+
 #include <fmt/format.h>
 
 #include <cmath>
@@ -15,67 +17,78 @@
 #include <memory>
 #include <optional>
 
-#include "commands/case_options.hpp"
 #include "commands/cli_checks.hpp"
 #include "commands/commands.hpp"
 #include "output/csv_writer.hpp"
 #include "output/gnuplot.hpp"
 #include "pwl/errors.hpp"
-#include "pwl/study/sweep_point.hpp"
 
 namespace pwl::app {
 namespace {
 
-struct AnalyzeOptions {
-  CaseOptions run;
-  int transient = 500;  // periods discarded
-  int mass = 0;         // 1-based mass for the figure and the 0-1 test; 0: the last one
-  // How λ1 is estimated; empty: from the whole tangent frame when the method has an exact tangent
-  // map, else from two nearby trajectories.
-  std::string lyapunov;
-  std::string out = "out";
-};
-
-// What analyze writes beside the pipeline's numbers, fed by the pipeline as it integrates.
-class AnalyzeOutputs : public analysis::PointObserver {
+// What analyze writes beside the pipeline's numbers, fed by the pipeline as it integrates. The
+// files are opened when the evaluation starts, once the flags have passed their checks.
+class AnalyzeFiles : public analysis::PointObserver {
  public:
-  AnalyzeOutputs(const std::string& folder, Index dofs, int mass, int drawn_from)
-      : poincare_(folder + "/poincare.csv", state_columns("t", dofs)),
-        trajectory_(folder + "/trajectory.csv",
-                    {"t", fmt::format("x{}", mass), fmt::format("v{}", mass)}),
-        dofs_(dofs),
-        mass_(mass),
-        drawn_from_(drawn_from) {}
+  AnalyzeFiles(const std::string& folder, int mass, int drawn_from)
+      : folder_(folder), mass_(mass), drawn_from_(drawn_from) {}
 
-  void started(const Integrator& integrator, const analysis::PointCase&) override {
-    integrator_name_ = integrator.name();
+  void started(const Integrator&, const analysis::PointCase& point) override {
+    dofs_ = point.structure.dofs();
+    if (mass_ == 0) mass_ = static_cast<int>(dofs_);
+    std::filesystem::create_directories(folder_);
+    poincare_ = std::make_unique<CsvWriter>(folder_ + "/poincare.csv", state_columns("t", dofs_));
+    trajectory_ = std::make_unique<CsvWriter>(
+        folder_ + "/trajectory.csv",
+        std::vector<std::string>{"t", fmt::format("x{}", mass_), fmt::format("v{}", mass_)});
   }
   StepObserver steps_of_period(int k) override {
     if (k <= drawn_from_) return {};
     return [this](double t, const Vector& x, const Vector& v) {
-      trajectory_.row({t, x[mass_ - 1], v[mass_ - 1]});
+      trajectory_->row({t, x[mass_ - 1], v[mass_ - 1]});
     };
   }
   void poincare_point(int, double t, const Vector& state) override {
-    poincare_.row(t, state.head(dofs_), state.tail(dofs_));
-  }
-  void classified(const analysis::Classification& c, const analysis::PointResult&) override {
-    classification_ = c;
-  }
-
-  const std::string& integrator_name() const { return integrator_name_; }
-  const std::optional<analysis::Classification>& classification() const {
-    return classification_;
+    poincare_->row(t, state.head(dofs_), state.tail(dofs_));
   }
 
  private:
-  CsvWriter poincare_;
-  CsvWriter trajectory_;
-  Index dofs_;
+  std::string folder_;
   int mass_;
   int drawn_from_;
-  std::string integrator_name_;
-  std::optional<analysis::Classification> classification_;
+  Index dofs_ = 0;
+  std::unique_ptr<CsvWriter> poincare_;
+  std::unique_ptr<CsvWriter> trajectory_;
+};
+
+// What analyze_case keeps of the evaluation, passing every hook on to `also`.
+class AnalyzeCollector : public analysis::PointObserver {
+ public:
+  AnalyzeCollector(AnalyzeResult& result, analysis::PointObserver* also)
+      : result_(result), also_(also) {}
+
+  void started(const Integrator& integrator, const analysis::PointCase& point) override {
+    result_.integrator = integrator.name();
+    if (also_ != nullptr) also_->started(integrator, point);
+  }
+  StepObserver steps_of_period(int k) override {
+    return also_ != nullptr ? also_->steps_of_period(k) : StepObserver();
+  }
+  void poincare_point(int k, double t, const Vector& state) override {
+    result_.section_times.push_back(t);
+    result_.section_periods.push_back(k);
+    result_.section_states.insert(result_.section_states.end(), state.data(),
+                                  state.data() + state.size());
+    if (also_ != nullptr) also_->poincare_point(k, t, state);
+  }
+  void classified(const analysis::Classification& c, const analysis::PointResult& r) override {
+    result_.classification = c;
+    if (also_ != nullptr) also_->classified(c, r);
+  }
+
+ private:
+  AnalyzeResult& result_;
+  analysis::PointObserver* also_;
 };
 
 std::string estimate_description(analysis::LyapunovEstimate estimate, const std::string& label) {
@@ -91,7 +104,9 @@ std::string estimate_description(analysis::LyapunovEstimate estimate, const std:
   return "";
 }
 
-void analyze(const AnalyzeOptions& o) {
+}  // namespace
+
+AnalyzeResult analyze_case(const AnalyzeOptions& o, analysis::PointObserver* also) {
   const GapStructure structure = o.run.structure();
   const Index n = structure.dofs();
   const int mass = o.mass == 0 ? static_cast<int>(n) : o.mass;
@@ -124,21 +139,53 @@ void analyze(const AnalyzeOptions& o) {
           method.name));
     }
   }
+  s.section = o.section.poincare_section(n);
+  const Vector start = o.run.start.state(n);
 
-  std::filesystem::create_directories(o.out);
-  analysis::PointResult result;
-  std::string integrator_name;
-  std::optional<analysis::Classification> c;
-  {
-    AnalyzeOutputs outputs(o.out, n, mass, o.run.periods - 20);
-    result = analysis::evaluate_point(analysis::PointCase(structure, period),
-                                      Vector::Zero(2 * n), s, &outputs);
-    integrator_name = outputs.integrator_name();
-    c = outputs.classification();
+  AnalyzeResult a;
+  a.settings = s;
+  a.dofs = n;
+  a.mass = mass;
+  a.period = period;
+  AnalyzeCollector collector(a, also);
+  a.result = analysis::evaluate_point(analysis::PointCase(structure, period), start, s, &collector);
+  return a;
+}
+
+void analyze(const AnalyzeOptions& o) {
+  AnalyzeResult a;
+  {  // the files close at the end of this block, before gnuplot reads them
+    AnalyzeFiles files(o.out, o.mass, o.run.periods - 20);
+    a = analyze_case(o, &files);
   }
-
-  fmt::print("case: n = {}, {}; {} Poincaré points after {} transient periods, by {}\n", n,
-             o.run.description(), recorded, o.transient, integrator_name);
+  const analysis::PointResult& result = a.result;
+  const std::optional<analysis::Classification>& c = a.classification;
+  const analysis::PointSettings& s = a.settings;
+  const MethodTraits& method = method_traits(s.method.method);
+  const Index n = a.dofs;
+  const int mass = a.mass;
+  const double period = a.period;
+  const int recorded = s.recorded_periods;
+  const std::string& integrator_name = a.integrator;
+  // The section and the start are said only when they are not the defaults, so that a default
+  // run prints and draws what it always has.
+  const std::string start = o.run.start.description();
+  if (s.section.is_default()) {
+    fmt::print("case: n = {}, {}{}; {} Poincaré points after {} transient periods, by {}\n", n,
+               o.run.description(), start, recorded, o.transient, integrator_name);
+  } else {
+    analysis::PoincareSection strobe;  // the stroboscopic points classified, at the phase
+    strobe.phase = s.section.phase;
+    fmt::print("case: n = {}, {}{}; {} stroboscopic points at {} after {} transient periods, by "
+               "{}\n",
+               n, o.run.description(), start, recorded, strobe.label(n), o.transient,
+               integrator_name);
+    if (!s.section.stroboscopic()) {
+      fmt::print("section: {} crossings of {} in the recorded periods (poincare.csv and the "
+                 "figure); the regime is that of the stroboscopic points\n",
+                 a.section_times.size(), s.section.label(n));
+    }
+  }
   fmt::print("regime: {}\n", result.regime);
   if (c) {
     fmt::print("  period search: {} (best k = {}, mismatch {:.2e}, {} distinct points)\n",
@@ -166,7 +213,18 @@ void analyze(const AnalyzeOptions& o) {
     return fmt::format(
         "trajectory='{0}/trajectory.csv'; poincare='{0}/poincare.csv'; out='{0}/analysis.{6}'; "
         "pxcol={1}; pvcol={2}; mass={3}; label='{4}: {5}'",
-        o.out, 1 + mass, 1 + n + mass, mass, o.run.description(), result.regime, format);
+        o.out, 1 + mass, 1 + n + mass, mass,
+        o.run.description() + start +
+            (s.section.is_default() ? std::string()
+                                    : fmt::format(", Poincaré section {}", s.section.label(n))),
+        result.regime, format) +
+           (s.section.is_default()
+                ? std::string()
+                : fmt::format("; ptitle={}",
+                              gnuplot_quoted(fmt::format(
+                                  "Poincaré section ({}, {})", s.section.label(n),
+                                  s.section.stroboscopic() ? "every recorded period"
+                                                           : "every crossing recorded"))));
   };
   if (draw_figure(scripts_directory() + "/analysis_panels.gp", definitions, &why)) {
     fmt::print("wrote {0}/poincare.csv, {0}/classification.csv, {0}/analysis.png and .svg\n",
@@ -176,25 +234,31 @@ void analyze(const AnalyzeOptions& o) {
   }
 }
 
-}  // namespace
+void add_analyze_flags(CLI::App& c, AnalyzeOptions& options) {
+  add_case_options(c, options.run);
+  add_section_flags(c, options.section,
+                    "poincare.csv and the figure's Poincaré panel get the section's\n"
+                    "points of the recorded periods");
+  c.add_option("--transient", options.transient, "Periods discarded before the analysis")
+      ->check(non_negative_number());
+  c.add_option("--mass", options.mass,
+               "Mass (1-based) drawn in the figure and read by the 0-1 test (default: last)");
+  c.add_option("--lyapunov", options.lyapunov,
+               "How λ1 is estimated: tangent-vector, tangent-frame or two-trajectories\n"
+               "(default, as pwl sweep and map: tangent-vector when the method has an exact\n"
+               "tangent map, else two-trajectories)")
+      ->check(CLI::IsMember({"tangent-vector", "tangent-frame", "two-trajectories"}));
+  c.add_option("--out", options.out, "Output folder");
+}
 
 void add_analyze_command(CLI::App& app) {
   auto options = std::make_shared<AnalyzeOptions>();
   CLI::App* c = app.add_subcommand(
       "analyze",
       "Classify the motion of one case (period-k, quasi-periodic, chaotic) with its evidence\n"
-      "Example: pwl analyze --figure 5 --periods 1000 --transient 500 --out fig5");
-  add_case_options(*c, options->run);
-  c->add_option("--transient", options->transient, "Periods discarded before the analysis")
-      ->check(non_negative_number());
-  c->add_option("--mass", options->mass,
-                "Mass (1-based) drawn in the figure and read by the 0-1 test (default: last)");
-  c->add_option("--lyapunov", options->lyapunov,
-                "How λ1 is estimated: tangent-vector, tangent-frame or two-trajectories\n"
-                "(default, as pwl sweep and map: tangent-vector when the method has an exact\n"
-                "tangent map, else two-trajectories)")
-      ->check(CLI::IsMember({"tangent-vector", "tangent-frame", "two-trajectories"}));
-  c->add_option("--out", options->out, "Output folder");
+      "Example: pwl analyze --figure 5 --periods 1000 --transient 500 --out fig5\n"
+      "         pwl analyze --figure 5 --section v5=0,down --out fig5_v5");
+  add_analyze_flags(*c, *options);
   c->callback([options] { analyze(*options); });
 }
 

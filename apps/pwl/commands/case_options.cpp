@@ -41,6 +41,78 @@ std::string method_help() {
   return help;
 }
 
+Vector InitialStateFlags::state(Index dofs) const {
+  Vector y = Vector::Zero(2 * dofs);
+  const auto fill = [&](const char* flag, const std::vector<double>& values, Index offset) {
+    if (values.empty()) return;
+    const std::size_t n = static_cast<std::size_t>(dofs);
+    if (values.size() != 1 && values.size() != n) {
+      throw InputError(fmt::format("{} {}: {} values for {} masses; give one per mass or one value "
+                                   "for every mass",
+                                   flag, fmt::join(values, ","), values.size(), dofs));
+    }
+    for (double value : values) {
+      if (!std::isfinite(value)) {
+        throw InputError(fmt::format("{} {}: {} is not a finite number", flag,
+                                     fmt::join(values, ","), value));
+      }
+    }
+    for (Index i = 0; i < dofs; ++i) {
+      y[offset + i] = values.size() == 1 ? values[0] : values[static_cast<std::size_t>(i)];
+    }
+  };
+  fill("--x0", x0, 0);
+  fill("--v0", v0, dofs);
+  return y;
+}
+
+std::string InitialStateFlags::text() const {
+  if (at_rest()) return "rest";
+  std::string text;
+  if (!x0.empty()) text += fmt::format("x0 = ({})", fmt::join(x0, ","));
+  if (!v0.empty()) text += fmt::format("{}v0 = ({})", text.empty() ? "" : ", ", fmt::join(v0, ","));
+  return text;
+}
+
+void add_initial_state_flags(CLI::App& c, InitialStateFlags& f) {
+  c.add_option("--x0", f.x0,
+               "Initial displacements at t = 0, comma separated: one per mass, or one value for\n"
+               "every mass (default: 0)")
+      ->delimiter(',');
+  c.add_option("--v0", f.v0,
+               "Initial velocities at t = 0, as --x0 (default: 0; both left out: from rest)")
+      ->delimiter(',');
+}
+
+analysis::PoincareSection SectionFlags::poincare_section(Index dofs) const {
+  analysis::PoincareSection s;
+  try {
+    s = analysis::parse_poincare_section(section, dofs);
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("--section {}: {}", section, e.what()));
+  }
+  if (!(phase >= 0.0 && phase < 1.0)) {
+    throw InputError(fmt::format(
+        "--phase {}: the phase is a fraction of the forcing period, 0 <= P < 1", phase));
+  }
+  s.phase = phase;
+  return s;
+}
+
+void add_section_flags(CLI::App& c, SectionFlags& f, const std::string& what) {
+  c.add_option("--section", f.section,
+               "Poincaré section: strobe (the states at t = (k + P) T, P = --phase), or a\n"
+               "hyperplane x<i>=<level>,<up|down|both> or v<i>=... (every crossing of that\n"
+               "component through the level in that direction, e.g. v3=0,down: the largest\n"
+               "excursions of mass 3). The regime, λ1 and K are properties of the motion and\n"
+               "stay classified on the stroboscopic map at --phase; the section changes which\n"
+               "points are recorded. " +
+                   what);
+  c.add_option("--phase", f.phase,
+               "Phase P of the stroboscopic points, a fraction of the forcing period T,\n"
+               "0 <= P < 1: the points at t = (k + P) T");
+}
+
 void add_case_options(CLI::App& c, CaseOptions& o) {
   add_chain_options(c, o.figure, o.masses, o.alpha, o.zeta, o.gap, o.theta, o.loads);
   c.add_option("--gaps", o.gaps, "Gaps per mass, comma separated (overrides --gap)")
@@ -62,6 +134,7 @@ void add_case_options(CLI::App& c, CaseOptions& o) {
       ->check(CLI::ExistingFile);
   c.add_option("--lcp", o.lcp_solver, "PIM's LCP solver: block-pivoting or lemke")
       ->check(CLI::IsMember({"block-pivoting", "lemke"}));
+  add_initial_state_flags(c, o.start);
 }
 
 GapStructure CaseOptions::structure() const {
@@ -142,7 +215,13 @@ MethodSettings CaseOptions::method_settings(double period) const {
 
 std::unique_ptr<Integrator> CaseOptions::integrator(const GapStructure& structure,
                                                     double period) const {
-  return make_integrator(structure, method_settings(period));
+  std::unique_ptr<Integrator> integrator = make_integrator(structure, method_settings(period));
+  if (!start.at_rest()) {
+    const Index n = structure.dofs();
+    const Vector y = start.state(n);
+    integrator->set_state(0.0, y.head(n), y.tail(n));
+  }
+  return integrator;
 }
 
 }  // namespace pwl::app

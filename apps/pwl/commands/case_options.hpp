@@ -1,6 +1,7 @@
 #pragma once
 // The flags that describe one case of the nondimensional chain and how to integrate it, shared by
-// the subcommands that run a single case (simulate, analyze).
+// the subcommands that run a single case (simulate, analyze, orbit, continue), and the flags of
+// the initial state and of the Poincaré section, which sweep and map take too.
 #include <CLI/CLI.hpp>
 #include <limits>
 #include <memory>
@@ -10,9 +11,46 @@
 #include "pwl/model/chain_builders.hpp"
 #include "pwl/integrators/integrator.hpp"
 #include "pwl/integrators/method_table.hpp"
+#include "pwl/analysis/poincare_section.hpp"
 #include "pwl/study/point_model.hpp"
 
 namespace pwl::app {
+
+// --x0 and --v0: the initial displacements and velocities of every job that integrates a case.
+// Each takes one value per mass, or one value for every mass (as --alpha and --loads do); either
+// left out is zero, so that by default a run starts at rest. The loads start at phase 0 (t = 0).
+struct InitialStateFlags {
+  std::vector<double> x0;
+  std::vector<double> v0;
+
+  bool at_rest() const { return x0.empty() && v0.empty(); }
+  // [x0; v0] for a structure of `dofs` degrees of freedom. Throws InputError naming the flag and
+  // its value for a count that is neither 1 nor dofs, or a value that is not finite.
+  Vector state(Index dofs) const;
+  // For messages: "rest", or the flags given ("x0 = (0.1), v0 = (0,1,0,0,0)").
+  std::string text() const;
+  // "" at rest, else " from " + text(): what a description of the case adds.
+  std::string description() const { return at_rest() ? std::string() : " from " + text(); }
+};
+void add_initial_state_flags(CLI::App& command, InitialStateFlags& flags);
+
+// --section and --phase: which Poincaré section a job records (see PoincareSection in
+// pwl/analysis/poincare_section.hpp). `strobe` (the default) takes the stroboscopic points at
+// t = (k + phase) T; a hyperplane, written like `v3=0,down` or `x2=0.1,up` (x<i> or v<i>, a level,
+// up|down|both), takes every crossing. The regime, λ1 and K stay classified on the stroboscopic
+// map at --phase whatever the section: they are properties of the motion; the section changes
+// which points are recorded, written and drawn.
+struct SectionFlags {
+  std::string section = "strobe";
+  double phase = 0.0;
+
+  // The section for a structure of `dofs` degrees of freedom. Throws InputError naming --section
+  // or --phase and the value: malformed text, a component out of range, a level or phase that is
+  // not finite, a phase outside [0, 1).
+  analysis::PoincareSection poincare_section(Index dofs) const;
+};
+// `what` completes --section's help: what the job does with the recorded points.
+void add_section_flags(CLI::App& command, SectionFlags& flags, const std::string& what);
 
 struct CaseOptions {
   std::string figure;  // a paper preset ("4a", "4b", "5", "6"); flags override it
@@ -35,6 +73,7 @@ struct CaseOptions {
   // An explicit structure from a scene file's [structure] table (scene_structure.hpp) instead of
   // the chain; the chain's flags do not apply then.
   std::string structure_scene;
+  InitialStateFlags start;  // --x0, --v0
 
   // The chain these flags describe (the preset, then each given flag).
   NondimensionalChain chain() const;
@@ -53,10 +92,12 @@ struct CaseOptions {
   double step(double period) const;
   // The method table's settings these flags give (the step only for fixed-grid methods).
   MethodSettings method_settings(double period) const;
-  // The integrator the flags name, with its state at rest at t = 0.
+  // The integrator the flags name, with its state at t = 0 that of --x0 and --v0 (rest when they
+  // are not given). Throws InputError naming --x0 or --v0 for a wrong value.
   std::unique_ptr<Integrator> integrator(const GapStructure& structure, double period) const;
 };
 
+// The case flags, --x0 and --v0 among them.
 void add_case_options(CLI::App& command, CaseOptions& options);
 
 // --method's help: one line per row of the method table.

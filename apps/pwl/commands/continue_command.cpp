@@ -19,6 +19,7 @@
 
 #include "commands/cli_checks.hpp"
 #include "commands/commands.hpp"
+#include "commands/continue_command.hpp"
 #include "commands/orbit_options.hpp"
 #include "commands/study_runner.hpp"
 #include "commands/sweep_command.hpp"
@@ -32,24 +33,6 @@ namespace pwl::app {
 namespace {
 
 constexpr int kAllDofsUpTo = 10;  // --record's default: every mass up to this many, else the last
-
-struct ContinueFlags {
-  OrbitFlags orbit;
-  std::string parameter;
-  std::string range;
-  bool switch_branches = false;
-  int max_branches = 4;
-  int max_points = 2000;
-  double step = 0.0;
-  double min_step = 0.0;
-  double max_step = 0.0;
-  std::vector<std::string> record;
-  bool no_grazing = false;
-  int over_sweep = 0;
-  int over_periods = 100;
-  bool no_plot = false;
-  int threads = 0;
-};
 
 // The masses --record names (1-based "5" or "x5"), 0-based; the default when empty.
 std::vector<int> recorded_dofs(const std::vector<std::string>& record, int n) {
@@ -108,17 +91,6 @@ void add_field(std::string& row, const std::string& field) {
   row += field;
 }
 
-// The detail column of bifurcations.csv.
-std::string detail_of(const orbits::Bifurcation& b) {
-  std::vector<std::string> parts;
-  if (b.type == orbits::BifurcationType::grazing) {
-    parts.emplace_back(b.at_largest_gap ? "largest gap" : "smallest gap");
-  }
-  if (b.to_branch >= 0) parts.push_back(fmt::format("starts branch {}", b.to_branch));
-  if (b.joined_by >= 0) parts.push_back(fmt::format("ends branch {}", b.joined_by));
-  if (!b.located) parts.emplace_back("not located (detected between two branch points)");
-  return fmt::format("{}", fmt::join(parts, "; "));
-}
 
 // What the continuation writes as it goes, and its progress on standard error.
 class ContinueOutputs : public orbits::ContinuationObserver {
@@ -242,7 +214,7 @@ class ContinueOutputs : public orbits::ContinuationObserver {
       row += fmt::format(",{},{},{}", number(b.multiplier.real()), number(b.multiplier.imag()),
                          number(std::abs(b.multiplier)));
     }
-    add_field(row, detail_of(b));
+    add_field(row, bifurcation_detail(b));
     // The amplitudes of the orbit there, for the figure's marks.
     const auto cached = amplitudes_.find(b.parameter);
     if (cached == amplitudes_.end()) {
@@ -317,7 +289,7 @@ void print_bifurcations(const std::vector<orbits::Bifurcation>& all, const std::
                grazing ? fmt::format("{}", b.spring + 1) : std::string("-"),
                grazing ? std::string("-") : multiplier_text(b.multiplier),
                grazing ? std::string("-") : fmt::format("{:.6f}", std::abs(b.multiplier)),
-               detail_of(b));
+               bifurcation_detail(b));
   }
 }
 
@@ -379,6 +351,8 @@ void run_over_sweep(const ContinueFlags& f, const analysis::PointModel& model,
   o.point.method = method.settings;
   o.point.lyapunov_estimate = analysis::default_lyapunov_estimate(method.settings.method);
   o.point.components = {dof, n + dof};
+  // Each branch of the diagram starts where the orbit's guess does: --x0/--v0, else rest.
+  if (!f.orbit.run.start.at_rest()) o.initial_state = f.orbit.run.start.state(n);
   std::string why;
   if (!o.is_valid(&why)) throw InputError(fmt::format("--over-sweep {}: {}", f.over_sweep, why));
   RunFlags run;
@@ -407,6 +381,92 @@ void run_over_sweep(const ContinueFlags& f, const analysis::PointModel& model,
 
 void continue_orbit(const ContinueFlags& f) {
   const auto start = std::chrono::steady_clock::now();
+  const OrbitFlags& o = f.orbit;
+  const ContinuationProblem problem = continuation_problem(f);
+  const analysis::PointModel& base = problem.base;
+  const analysis::SweepParameter& parameter = problem.parameter;
+  const double from = problem.from, to = problem.to;
+  const int n = base.dofs();
+  const std::vector<int>& dofs = problem.dofs;
+  const analysis::PointCase& first_case = problem.first_case;
+  const OrbitMethod& method = problem.method;
+  const orbits::ContinuationOptions& c = problem.options;
+
+  Vector guess;
+  {
+    orbits::StroboscopicMap map(first_case, method.settings, method.steps_per_period);
+    note_when_no_tangent_map(map);
+    guess = starting_guess(o, map);
+  }
+  std::string title = fmt::format(
+      "pwl continue in {} of the period-{} orbit (base case {}; {})", parameter.name(), o.period,
+      base.explicit_structure() ? base.structure().label : o.run.description(),
+      orbit_method_label(method));
+  // For a gnuplot title: no single quotes, underscores escaped (enhanced text's subscript).
+  title.erase(std::remove(title.begin(), title.end(), '\''), title.end());
+  for (std::size_t at = title.find('_'); at != std::string::npos; at = title.find('_', at + 2)) {
+    title.insert(at, "\\");
+  }
+  fmt::print("continuation of the period-{} orbit of n = {}, {} in {} from {} to {}, by {}{}\n",
+             o.period, n, o.run.description(), parameter.name(), from, to,
+             orbit_method_label(method), method.chosen ? " (the default for orbits)" : "");
+  fmt::print("guess at {} = {}: {}\n", parameter.name(), from,
+             o.guess_file.empty()
+                 ? fmt::format("the state {} forcing periods after {}", o.transient, o.run.start.text())
+                 : o.guess_file);
+  std::filesystem::create_directories(o.out);
+  ContinueOutputs outputs(o.out, base, parameter, method, dofs, !o.quiet);
+  orbits::ContinuationResult result;
+  try {
+    result = orbits::continue_periodic_orbit(base, guess, c, &outputs);
+  } catch (...) {
+    outputs.finish_progress();
+    throw;
+  }
+  outputs.finish_progress();
+  outputs.rewrite_bifurcations(o.out, result.bifurcations);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  fmt::print("start: Newton at {} = {}: residual {:.3e} after {} iteration(s)\n", parameter.name(),
+             from, outputs.first_residual(), outputs.first_iterations());
+  for (const auto& [branch, count] : outputs.per_branch()) {
+    const auto& [lo, hi] = outputs.range().at(branch);
+    const auto stable = outputs.stable().find(branch);
+    fmt::print("branch {} (period {}): {} points, {} from {:.10g} to {:.10g}, {} stable\n", branch,
+               outputs.period().at(branch), count, parameter.name(), lo, hi,
+               stable == outputs.stable().end() ? 0 : stable->second);
+  }
+  print_bifurcations(result.bifurcations, parameter.name());
+  if (!result.notes.empty()) {
+    fmt::print("notes:\n");
+    for (const std::string& note : result.notes) fmt::print("  {}\n", note);
+  }
+  fmt::print("time: {:.2f} s ({} points)\n", seconds, outputs.points());
+  fmt::print("wrote {0}/branch.csv, {0}/branch_section.csv and {0}/bifurcations.csv\n", o.out);
+  if (!f.no_plot) {
+    draw_frequency_response(f, outputs, result.bifurcations, dofs, parameter,
+                            !base.explicit_structure(), title);
+  }
+  if (f.over_sweep > 0) {
+    run_over_sweep(f, base, parameter, method, from, to, dofs, title);
+  }
+}
+
+}  // namespace
+
+std::string bifurcation_detail(const orbits::Bifurcation& b) {
+  std::vector<std::string> parts;
+  if (b.type == orbits::BifurcationType::grazing) {
+    parts.emplace_back(b.at_largest_gap ? "largest gap" : "smallest gap");
+  }
+  if (b.to_branch >= 0) parts.push_back(fmt::format("starts branch {}", b.to_branch));
+  if (b.joined_by >= 0) parts.push_back(fmt::format("ends branch {}", b.joined_by));
+  if (!b.located) parts.emplace_back("not located (detected between two branch points)");
+  return fmt::format("{}", fmt::join(parts, "; "));
+}
+
+ContinuationProblem continuation_problem(const ContinueFlags& f) {
   const OrbitFlags& o = f.orbit;
   check_orbit_flags(o);
   const analysis::PointModel base = o.run.model();
@@ -456,68 +516,60 @@ void continue_orbit(const ContinueFlags& f) {
   c.shooting.solver = orbits::ShootingSolver::dense;
   if (!c.is_valid(&why)) throw InputError(why);
 
-  Vector guess;
-  {
-    orbits::StroboscopicMap map(first_case, method.settings, method.steps_per_period);
-    note_when_no_tangent_map(map);
-    guess = starting_guess(o, map);
-  }
-  std::string title = fmt::format(
-      "pwl continue in {} of the period-{} orbit (base case {}; {})", parameter.name(), o.period,
-      base.explicit_structure() ? base.structure().label : o.run.description(),
-      orbit_method_label(method));
-  // For a gnuplot title: no single quotes, underscores escaped (enhanced text's subscript).
-  title.erase(std::remove(title.begin(), title.end(), '\''), title.end());
-  for (std::size_t at = title.find('_'); at != std::string::npos; at = title.find('_', at + 2)) {
-    title.insert(at, "\\");
-  }
-  fmt::print("continuation of the period-{} orbit of n = {}, {} in {} from {} to {}, by {}{}\n",
-             o.period, n, o.run.description(), parameter.name(), from, to,
-             orbit_method_label(method), method.chosen ? " (the default for orbits)" : "");
-  fmt::print("guess at {} = {}: {}\n", parameter.name(), from,
-             o.guess_file.empty()
-                 ? fmt::format("the state {} forcing periods after rest", o.transient)
-                 : o.guess_file);
-  std::filesystem::create_directories(o.out);
-  ContinueOutputs outputs(o.out, base, parameter, method, dofs, !o.quiet);
-  orbits::ContinuationResult result;
-  try {
-    result = orbits::continue_periodic_orbit(base, guess, c, &outputs);
-  } catch (...) {
-    outputs.finish_progress();
-    throw;
-  }
-  outputs.finish_progress();
-  outputs.rewrite_bifurcations(o.out, result.bifurcations);
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-
-  fmt::print("start: Newton at {} = {}: residual {:.3e} after {} iteration(s)\n", parameter.name(),
-             from, outputs.first_residual(), outputs.first_iterations());
-  for (const auto& [branch, count] : outputs.per_branch()) {
-    const auto& [lo, hi] = outputs.range().at(branch);
-    const auto stable = outputs.stable().find(branch);
-    fmt::print("branch {} (period {}): {} points, {} from {:.10g} to {:.10g}, {} stable\n", branch,
-               outputs.period().at(branch), count, parameter.name(), lo, hi,
-               stable == outputs.stable().end() ? 0 : stable->second);
-  }
-  print_bifurcations(result.bifurcations, parameter.name());
-  if (!result.notes.empty()) {
-    fmt::print("notes:\n");
-    for (const std::string& note : result.notes) fmt::print("  {}\n", note);
-  }
-  fmt::print("time: {:.2f} s ({} points)\n", seconds, outputs.points());
-  fmt::print("wrote {0}/branch.csv, {0}/branch_section.csv and {0}/bifurcations.csv\n", o.out);
-  if (!f.no_plot) {
-    draw_frequency_response(f, outputs, result.bifurcations, dofs, parameter,
-                            !base.explicit_structure(), title);
-  }
-  if (f.over_sweep > 0) {
-    run_over_sweep(f, base, parameter, method, from, to, dofs, title);
-  }
+  return {base, parameter, from, to, dofs, first_case, method, c};
 }
 
-}  // namespace
+void add_continue_flags(CLI::App& command, ContinueFlags& flags) {
+  add_orbit_flags(command, flags.orbit, false);
+  flags.orbit.out = "continuation";
+  command.get_option("--out")->default_str("continuation");
+  command.get_option("--transient")
+      ->description("Guess: the state this many forcing periods after rest, at the start of\n"
+                    "--range (also each --over-sweep point's transient)");
+  command.add_option("--parameter", flags.parameter,
+                     "Parameter followed: theta, alpha, zeta, gap (Δ̃) or amplitude (scales Q) of "
+                     "the\n"
+                     "chain; spring<j>.stiffness, spring<j>.gap, load<j>.amplitude, "
+                     "load<j>.frequency\n"
+                     "or damping (scales C) of a --structure-scene (j from 1)")
+      ->required();
+  command.add_option("--range", flags.range,
+                     "FROM:TO: the branch starts at FROM and is followed toward TO (either order)")
+      ->required();
+  command.add_flag("--switch-branches", flags.switch_branches,
+                   "At each period doubling, follow the period-2k branch born there too");
+  command.add_option("--max-branches", flags.max_branches, "Branches switched onto, at most")
+      ->check(non_negative_number());
+  command.add_option("--max-points", flags.max_points, "Points per branch, at most")
+      ->check(positive_number());
+  command.add_option("--step", flags.step,
+                     "Arclength of the first step (0: |TO − FROM|/100)")
+      ->check(non_negative_number());
+  command.add_option("--min-step", flags.min_step,
+                     "Smallest step; a branch stops below it (0: 1e-7 |TO − FROM|)")
+      ->check(non_negative_number());
+  command.add_option("--max-step", flags.max_step, "Largest step (0: |TO − FROM|/25)")
+      ->check(non_negative_number());
+  command.add_option("--record", flags.record,
+                     "Masses whose amplitude and state branch.csv keeps, comma separated (5 or "
+                     "x5);\n"
+                     "the figures draw the last one. Default: every mass up to 10, else the last")
+      ->delimiter(',');
+  command.add_flag("--no-grazing", flags.no_grazing, "Do not look for grazing bifurcations");
+  command.add_option("--over-sweep", flags.over_sweep,
+                     "Also run the brute-force bifurcation diagram of the range (pwl sweep by\n"
+                     "continuation, up and down) with this many values into OUT/over_sweep, and "
+                     "draw\n"
+                     "the branches over it (OUT/branch_over_diagram.png)")
+      ->check(non_negative_number());
+  command.add_option("--over-periods", flags.over_periods,
+                     "Poincaré points recorded per value of --over-sweep (after --transient)")
+      ->check(positive_number());
+  command.add_flag("--no-plot", flags.no_plot, "Write the CSV files only");
+  command.add_option("--threads", flags.threads,
+                     "OpenMP threads of --over-sweep (default: all cores)")
+      ->check(non_negative_number());
+}
 
 void add_continue_command(CLI::App& app) {
   auto flags = std::make_shared<ContinueFlags>();
@@ -528,50 +580,7 @@ void add_continue_command(CLI::App& app) {
       "Example: pwl continue --figure 5 --parameter theta --range 0.5:3 --out theta_branch\n"
       "         pwl continue --figure 5 --parameter theta --range 0.5:3 --switch-branches \\\n"
       "           --over-sweep 200 --out theta_branch");
-  add_orbit_flags(*c, flags->orbit, false);
-  flags->orbit.out = "continuation";
-  c->get_option("--out")->default_str("continuation");
-  c->get_option("--transient")
-      ->description("Guess: the state this many forcing periods after rest, at the start of\n"
-                    "--range (also each --over-sweep point's transient)");
-  c->add_option("--parameter", flags->parameter,
-                "Parameter followed: theta, alpha, zeta, gap (Δ̃) or amplitude (scales Q) of the\n"
-                "chain; spring<j>.stiffness, spring<j>.gap, load<j>.amplitude, load<j>.frequency\n"
-                "or damping (scales C) of a --structure-scene (j from 1)")
-      ->required();
-  c->add_option("--range", flags->range,
-                "FROM:TO: the branch starts at FROM and is followed toward TO (either order)")
-      ->required();
-  c->add_flag("--switch-branches", flags->switch_branches,
-              "At each period doubling, follow the period-2k branch born there too");
-  c->add_option("--max-branches", flags->max_branches, "Branches switched onto, at most")
-      ->check(non_negative_number());
-  c->add_option("--max-points", flags->max_points, "Points per branch, at most")
-      ->check(positive_number());
-  c->add_option("--step", flags->step,
-                "Arclength of the first step (0: |TO − FROM|/100)")
-      ->check(non_negative_number());
-  c->add_option("--min-step", flags->min_step,
-                "Smallest step; a branch stops below it (0: 1e-7 |TO − FROM|)")
-      ->check(non_negative_number());
-  c->add_option("--max-step", flags->max_step, "Largest step (0: |TO − FROM|/25)")
-      ->check(non_negative_number());
-  c->add_option("--record", flags->record,
-                "Masses whose amplitude and state branch.csv keeps, comma separated (5 or x5);\n"
-                "the figures draw the last one. Default: every mass up to 10, else the last")
-      ->delimiter(',');
-  c->add_flag("--no-grazing", flags->no_grazing, "Do not look for grazing bifurcations");
-  c->add_option("--over-sweep", flags->over_sweep,
-                "Also run the brute-force bifurcation diagram of the range (pwl sweep by\n"
-                "continuation, up and down) with this many values into OUT/over_sweep, and draw\n"
-                "the branches over it (OUT/branch_over_diagram.png)")
-      ->check(non_negative_number());
-  c->add_option("--over-periods", flags->over_periods,
-                "Poincaré points recorded per value of --over-sweep (after --transient)")
-      ->check(positive_number());
-  c->add_flag("--no-plot", flags->no_plot, "Write the CSV files only");
-  c->add_option("--threads", flags->threads, "OpenMP threads of --over-sweep (default: all cores)")
-      ->check(non_negative_number());
+  add_continue_flags(*c, *flags);
   c->callback([c, flags] {
     read_method_given(*c, flags->orbit);
     continue_orbit(*flags);

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "commands/commands.hpp"
+#include "commands/map_command.hpp"
 #include "output/gnuplot.hpp"
 #include "pwl/study/regime_map.hpp"
 #include "pwl/errors.hpp"
@@ -13,43 +14,6 @@
 
 namespace pwl::app {
 namespace {
-
-struct MapFlags {
-  ModelFlags model;
-  PointFlags point;
-  RunFlags run;
-  std::string x = "theta";
-  std::string x_range = "0.5:3";
-  int x_points = 20;
-  std::string y = "alpha";
-  std::string y_range = "1:15";
-  int y_points = 15;
-  std::string mode = "independent";
-  MapFlags() { run.out = "map"; }
-};
-
-analysis::RegimeMapOptions map_options(const MapFlags& f) {
-  analysis::RegimeMapOptions o;
-  const analysis::PointModel model = f.model.model();
-  if (model.explicit_structure()) {
-    o.structure = model.structure();
-  } else {
-    o.chain = model.chain();
-  }
-  o.first.parameter = parse_model_parameter(model, "--x", f.x);
-  parse_range("--x-range", f.x_range, &o.first.from, &o.first.to);
-  o.first.points = f.x_points;
-  o.second.parameter = parse_model_parameter(model, "--y", f.y);
-  parse_range("--y-range", f.y_range, &o.second.from, &o.second.to);
-  o.second.points = f.y_points;
-  o.mode = f.mode == "continuation" ? analysis::SweepMode::continuation
-                                    : analysis::SweepMode::independent;
-  o.point = f.point.settings(model.dofs());
-  o.point.components.clear();
-  std::string why;
-  if (!o.is_valid(&why)) throw InputError(why);
-  return o;
-}
 
 void map(const MapFlags& f) {
   const analysis::RegimeMapOptions o = map_options(f);
@@ -80,6 +44,62 @@ void map(const MapFlags& f) {
 
 }  // namespace
 
+analysis::RegimeMapOptions map_options(const MapFlags& f) {
+  analysis::RegimeMapOptions o;
+  const analysis::PointModel model = f.model.model();
+  if (model.explicit_structure()) {
+    o.structure = model.structure();
+  } else {
+    o.chain = model.chain();
+  }
+  o.first.parameter = parse_model_parameter(model, "--x", f.x);
+  parse_range("--x-range", f.x_range, &o.first.from, &o.first.to);
+  o.first.points = f.x_points;
+  o.second.parameter = parse_model_parameter(model, "--y", f.y);
+  parse_range("--y-range", f.y_range, &o.second.from, &o.second.to);
+  o.second.points = f.y_points;
+  o.mode = f.mode == "continuation" ? analysis::SweepMode::continuation
+                                    : analysis::SweepMode::independent;
+  o.point = f.point.settings(model.dofs());
+  o.point.components.clear();
+  o.point.section = f.section.poincare_section(model.dofs());
+  if (!o.point.section.stroboscopic()) {
+    throw InputError(fmt::format(
+        "--section {}: a regime map keeps no Poincaré points, only each cell's regime, λ1 and K, "
+        "which are classified on the stroboscopic map (at --phase) whatever the section records; "
+        "record a hyperplane section with pwl sweep or pwl analyze",
+        f.section.section));
+  }
+  if (!f.start.at_rest()) o.initial_state = f.start.state(model.dofs());
+  std::string why;
+  if (!o.is_valid(&why)) throw InputError(why);
+  return o;
+}
+
+void add_map_flags(CLI::App& c, MapFlags& flags) {
+  add_model_flags(c, flags.model);
+  c.add_option("--x", flags.x,
+               "Horizontal parameter: theta, alpha, zeta, gap or amplitude of the chain;\n"
+               "spring<j>.stiffness, spring<j>.gap, load<j>.amplitude, load<j>.frequency or\n"
+               "damping of a --structure-scene");
+  c.add_option("--x-range", flags.x_range, "FROM:TO of the horizontal parameter");
+  c.add_option("--x-points", flags.x_points, "Values of the horizontal parameter");
+  c.add_option("--y", flags.y, "Vertical parameter");
+  c.add_option("--y-range", flags.y_range, "FROM:TO of the vertical parameter");
+  c.add_option("--y-points", flags.y_points, "Values of the vertical parameter");
+  c.add_option("--mode", flags.mode,
+               "independent (every cell from rest, or from --x0/--v0) or continuation (each row\n"
+               "upward in the horizontal parameter from the previous cell's final state, its\n"
+               "first cell from rest or --x0/--v0)")
+      ->check(CLI::IsMember({"independent", "continuation"}));
+  add_point_flags(c, flags.point, false);
+  add_section_flags(c, flags.section,
+                    "A map keeps no Poincaré points, so only strobe is\n"
+                    "accepted: --phase sets the stroboscopic points each cell is classified on");
+  add_initial_state_flags(c, flags.start);
+  add_run_flags(c, flags.run);
+}
+
 void add_map_command(CLI::App& app) {
   auto flags = std::make_shared<MapFlags>();
   CLI::App* c = app.add_subcommand(
@@ -87,22 +107,7 @@ void add_map_command(CLI::App& app) {
       "Regime map: classify every cell of a two-parameter grid\n"
       "Example: pwl map --figure 5 --x theta --x-range 0.5:3 --x-points 40 --y alpha \\\n"
       "           --y-range 1:15 --y-points 29 --out theta_alpha");
-  add_model_flags(*c, flags->model);
-  c->add_option("--x", flags->x,
-                "Horizontal parameter: theta, alpha, zeta, gap or amplitude of the chain;\n"
-                "spring<j>.stiffness, spring<j>.gap, load<j>.amplitude, load<j>.frequency or\n"
-                "damping of a --structure-scene");
-  c->add_option("--x-range", flags->x_range, "FROM:TO of the horizontal parameter");
-  c->add_option("--x-points", flags->x_points, "Values of the horizontal parameter");
-  c->add_option("--y", flags->y, "Vertical parameter");
-  c->add_option("--y-range", flags->y_range, "FROM:TO of the vertical parameter");
-  c->add_option("--y-points", flags->y_points, "Values of the vertical parameter");
-  c->add_option("--mode", flags->mode,
-                "independent (every cell from rest) or continuation (each row upward in the "
-                "horizontal parameter from the previous cell's final state)")
-      ->check(CLI::IsMember({"independent", "continuation"}));
-  add_point_flags(*c, flags->point, false);
-  add_run_flags(*c, flags->run);
+  add_map_flags(*c, *flags);
   c->callback([flags] { map(*flags); });
 }
 

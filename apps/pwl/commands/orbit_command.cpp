@@ -11,6 +11,7 @@
 
 #include "commands/cli_checks.hpp"
 #include "commands/commands.hpp"
+#include "commands/orbit_command.hpp"
 #include "commands/orbit_options.hpp"
 #include "output/csv_writer.hpp"
 #include "pwl/errors.hpp"
@@ -21,14 +22,6 @@ namespace pwl::app {
 namespace {
 
 constexpr Index kPathDofs = 100;  // orbit_path.csv is written up to this many masses
-
-struct OrbitCommandFlags {
-  OrbitFlags orbit;
-  int shots = 1;
-  std::string solver = "automatic";
-  int floquet_count = 6;
-  bool no_path = false;
-};
 
 // orbit_path.csv: t and x1..xn at every step of a fixed-grid method (every T/steps of another)
 // over the k periods of the orbit from its state at t = 0.
@@ -57,35 +50,13 @@ void write_path(orbits::StroboscopicMap& map, const Vector& state, int periods, 
 void orbit(const OrbitCommandFlags& f) {
   const auto start = std::chrono::steady_clock::now();
   const OrbitFlags& o = f.orbit;
-  check_orbit_flags(o);
-  if (f.shots < 1) throw InputError(fmt::format("--shots = {} must be >= 1", f.shots));
-  const analysis::PointModel model = o.run.model();
-  const analysis::PointCase point = model.point_case();
-  const Index n = point.structure.dofs();
-  const OrbitMethod method = orbit_method(o, point.structure, point.period);
-
-  orbits::ShootingOptions shooting = shooting_options(o);
-  shooting.shots = f.shots;
-  shooting.solver = orbits::parse_shooting_solver(f.solver);
-  shooting.arnoldi.count = f.floquet_count;
-  shooting.arnoldi.krylov_dimension = std::max(shooting.arnoldi.krylov_dimension, 2 * f.floquet_count + 10);
-  if (f.shots > 1 && shooting.solver == orbits::ShootingSolver::krylov) {
-    throw InputError(fmt::format("--shots {}: multiple shooting needs --solver dense or automatic",
-                                 f.shots));
-  }
-  if (f.shots > 1 && f.shots % o.period != 0 && o.period % f.shots != 0) {
-    throw InputError(fmt::format(
-        "--shots {}: the arcs of multiple shooting divide the {} period(s) of the orbit (shots a "
-        "divisor of --period) or each period (a multiple of it)",
-        f.shots, o.period));
-  }
-  std::string why;
-  if (!shooting.is_valid(&why)) throw InputError(why);
-
-  orbits::StroboscopicMap map(point, method.settings, method.steps_per_period);
+  OrbitProblem problem = orbit_problem(f);
+  const Index n = problem.point.structure.dofs();
+  const OrbitMethod& method = problem.method;
+  orbits::StroboscopicMap& map = *problem.map;
   note_when_no_tangent_map(map);
   const Vector guess = starting_guess(o, map);
-  const orbits::PeriodicOrbit orbit = orbits::find_periodic_orbit(map, guess, shooting);
+  const orbits::PeriodicOrbit orbit = orbits::find_periodic_orbit(map, guess, problem.shooting);
 
   std::filesystem::create_directories(o.out);
   {
@@ -110,7 +81,7 @@ void orbit(const OrbitCommandFlags& f) {
   fmt::print("case: n = {}, {}; period-{} orbit by {}{}\n", n, o.run.description(), o.period,
              orbit_method_label(method), method.chosen ? " (the default for orbits)" : "");
   fmt::print("guess: {}\n", o.guess_file.empty()
-                                ? fmt::format("the state {} forcing periods after rest", o.transient)
+                                ? fmt::format("the state {} forcing periods after {}", o.transient, o.run.start.text())
                                 : o.guess_file);
   fmt::print("Newton: {} iteration(s), residual |φ(y) − y|_∞ = {:.3e} (tolerance {:.1e}), {} "
              "integrations of the map, {} solver{}\n",
@@ -134,6 +105,58 @@ void orbit(const OrbitCommandFlags& f) {
 
 }  // namespace
 
+OrbitProblem orbit_problem(const OrbitCommandFlags& f) {
+  const OrbitFlags& o = f.orbit;
+  check_orbit_flags(o);
+  if (f.shots < 1) throw InputError(fmt::format("--shots = {} must be >= 1", f.shots));
+  analysis::PointModel model = o.run.model();
+  analysis::PointCase point = model.point_case();
+  const OrbitMethod method = orbit_method(o, point.structure, point.period);
+
+  orbits::ShootingOptions shooting = shooting_options(o);
+  shooting.shots = f.shots;
+  shooting.solver = orbits::parse_shooting_solver(f.solver);
+  shooting.arnoldi.count = f.floquet_count;
+  shooting.arnoldi.krylov_dimension =
+      std::max(shooting.arnoldi.krylov_dimension, 2 * f.floquet_count + 10);
+  if (f.shots > 1 && shooting.solver == orbits::ShootingSolver::krylov) {
+    throw InputError(fmt::format("--shots {}: multiple shooting needs --solver dense or automatic",
+                                 f.shots));
+  }
+  if (f.shots > 1 && f.shots % o.period != 0 && o.period % f.shots != 0) {
+    throw InputError(fmt::format(
+        "--shots {}: the arcs of multiple shooting divide the {} period(s) of the orbit (shots a "
+        "divisor of --period) or each period (a multiple of it)",
+        f.shots, o.period));
+  }
+  std::string why;
+  if (!shooting.is_valid(&why)) throw InputError(why);
+  auto map = std::make_unique<orbits::StroboscopicMap>(point, method.settings,
+                                                       method.steps_per_period);
+  return {std::move(model), std::move(point), method, shooting, std::move(map)};
+}
+
+void add_orbit_command_flags(CLI::App& command, OrbitCommandFlags& flags) {
+  add_orbit_flags(command, flags.orbit, true);
+  command.add_option("--shots", flags.shots,
+                     "Multiple shooting: arcs of the orbit (a divisor of --period, or a multiple "
+                     "of it:\n"
+                     "that many arcs per period); for strongly unstable orbits")
+      ->check(positive_number());
+  command.add_option("--solver", flags.solver,
+                     "Newton's linear algebra: dense (form the monodromy), krylov (GMRES on "
+                     "products,\n"
+                     "Arnoldi for the leading multipliers) or automatic (dense up to 400 state\n"
+                     "components)")
+      ->check(CLI::IsMember({"automatic", "dense", "krylov"}));
+  command.add_option("--floquet-count", flags.floquet_count,
+                     "Krylov: how many leading multipliers Arnoldi computes")
+      ->check(positive_number());
+  command.add_flag(
+      "--no-path", flags.no_path,
+      "Leave out orbit_path.csv (t, x1..xn over the orbit; written up to 100 masses)");
+}
+
 void add_orbit_command(CLI::App& app) {
   auto flags = std::make_shared<OrbitCommandFlags>();
   CLI::App* c = app.add_subcommand(
@@ -142,21 +165,7 @@ void add_orbit_command(CLI::App& app) {
       "its stability, whether the motion settles on it or not\n"
       "Example: pwl orbit --figure 4a --period 1 --out orbit4a\n"
       "         pwl orbit --figure 4a --period 2 --guess-file orbit4a/orbit.csv --out orbit4a2");
-  add_orbit_flags(*c, flags->orbit, true);
-  c->add_option("--shots", flags->shots,
-                "Multiple shooting: arcs of the orbit (a divisor of --period, or a multiple of it:\n"
-                "that many arcs per period); for strongly unstable orbits")
-      ->check(positive_number());
-  c->add_option("--solver", flags->solver,
-                "Newton's linear algebra: dense (form the monodromy), krylov (GMRES on products,\n"
-                "Arnoldi for the leading multipliers) or automatic (dense up to 400 state\n"
-                "components)")
-      ->check(CLI::IsMember({"automatic", "dense", "krylov"}));
-  c->add_option("--floquet-count", flags->floquet_count,
-                "Krylov: how many leading multipliers Arnoldi computes")
-      ->check(positive_number());
-  c->add_flag("--no-path", flags->no_path,
-              "Leave out orbit_path.csv (t, x1..xn over the orbit; written up to 100 masses)");
+  add_orbit_command_flags(*c, *flags);
   c->callback([c, flags] {
     read_method_given(*c, flags->orbit);
     orbit(*flags);

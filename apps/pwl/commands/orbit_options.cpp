@@ -151,9 +151,16 @@ void note_when_no_tangent_map(const orbits::StroboscopicMap& map) {
 }
 
 Vector starting_guess(const OrbitFlags& f, orbits::StroboscopicMap& map) {
-  if (!f.guess_file.empty()) return read_state_file("--guess-file", f.guess_file, map.dofs());
-  const Vector rest = Vector::Zero(map.state_size());
-  return f.transient > 0 ? map.advance(rest, f.transient) : rest;
+  if (!f.guess_file.empty()) {
+    if (!f.run.start.at_rest()) {
+      throw InputError(fmt::format("--guess-file {}: --x0/--v0 ({}) start the transient that "
+                                   "gives the guess instead; give one or the other",
+                                   f.guess_file, f.run.start.text()));
+    }
+    return read_state_file("--guess-file", f.guess_file, map.dofs());
+  }
+  const Vector start = f.run.start.state(map.dofs());
+  return f.transient > 0 ? map.advance(start, f.transient) : start;
 }
 
 void check_orbit_flags(const OrbitFlags& f) {

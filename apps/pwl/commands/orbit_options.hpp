@@ -55,7 +55,8 @@ Vector read_state_file(const std::string& flag, const std::string& path, Index d
 void note_when_no_tangent_map(const orbits::StroboscopicMap& map);
 
 // The starting guess: the state in --guess-file, or the state --transient forcing periods after
-// rest, by `map` (its structure is the case the guess is for).
+// the initial state of --x0/--v0 (rest by default), by `map` (its structure is the case the guess
+// is for). InputError for --guess-file with --x0/--v0, or a bad --x0/--v0.
 Vector starting_guess(const OrbitFlags& flags, orbits::StroboscopicMap& map);
 
 // ShootingOptions from the flags (period, tolerance, iterations); `flag_prefix`-free checks.

@@ -264,6 +264,14 @@ void run_study(const Study& study, const RunFlags& flags) {
   }
 }
 
+std::map<long, analysis::PointResult> compute_study(const Study& study, int threads) {
+  std::map<long, analysis::PointResult> records;
+  analysis::run_grid(study.tasks, study.case_of, study.initial_state, study.settings, {},
+                     [&](long id, const analysis::PointResult& r) { records.emplace(id, r); },
+                     {threads});
+  return records;
+}
+
 std::string parameter_label(const analysis::SweepParameter& parameter) {
   using Kind = analysis::SweepParameter::Kind;
   const int j = parameter.index() + 1;
@@ -320,6 +328,9 @@ std::string study_title(const analysis::PointModel& model, const analysis::Point
   }
   std::string title = fmt::format("{}; {} + {} periods per point, {}", base,
                                   point.transient_periods, point.recorded_periods, integration);
+  if (!point.section.is_default()) {
+    title += fmt::format("; section {}", point.section.label(model.dofs()));
+  }
   title.erase(std::remove(title.begin(), title.end(), '\''), title.end());
   return title;
 }

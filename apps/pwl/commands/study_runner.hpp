@@ -97,13 +97,19 @@ Study study_of(const GridOptions& o) {
 // Runs the study into flags.out. Throws InputError for a resume that does not match.
 void run_study(const Study& study, const RunFlags& flags);
 
+// Computes every point of `study` in this process and returns the records by id (what `finish`
+// would get), with no folder, journal, progress bar or MPI: how an embedding runs a sweep or a
+// map in memory. `threads` as --threads (0: the OpenMP default). Throws what evaluate_point
+// throws (InputError for invalid settings).
+std::map<long, analysis::PointResult> compute_study(const Study& study, int threads = 0);
+
 // Parses a range "a:b" into its ends; throws InputError naming the flag otherwise.
 void parse_range(const std::string& flag, const std::string& text, double* from, double* to);
 
 // Figure text: the axis label of a swept parameter ("θ = ω/ω0", "gap Δ of spring 1"), and a title
 // line stating the base case and the integration ("base case: 5 masses, α = 5, ζ = 0.2, Δ̃ = 0,
-// Q = (1,-1,1,-1,1); 300 + 200 periods per point, η = T/200"). Single quotes are left out (gnuplot
-// strings).
+// Q = (1,-1,1,-1,1); 300 + 200 periods per point, η = T/200", then the section when it is not the
+// default: "; section v3 = 0 going down"). Single quotes are left out (gnuplot strings).
 std::string parameter_label(const analysis::SweepParameter& parameter);
 std::string study_title(const analysis::PointModel& model, const analysis::PointSettings& point);
 

@@ -21,39 +21,6 @@
 namespace pwl::app {
 namespace {
 
-struct SweepFlags {
-  ModelFlags model;
-  PointFlags point;
-  RunFlags run;
-  std::string parameter = "theta";
-  std::string range = "0.5:3";
-  int points = 100;
-  std::string mode = "independent";
-  std::string directions = "both";
-  std::string branches;  // a pwl continue folder whose branch_section.csv the figure draws
-};
-
-analysis::SweepOptions sweep_options(const SweepFlags& f) {
-  analysis::SweepOptions o;
-  const analysis::PointModel model = f.model.model();
-  if (model.explicit_structure()) {
-    o.structure = model.structure();
-  } else {
-    o.chain = model.chain();
-  }
-  o.parameter = parse_model_parameter(model, "--parameter", f.parameter);
-  parse_range("--range", f.range, &o.from, &o.to);
-  o.points = f.points;
-  o.mode = f.mode == "continuation" ? analysis::SweepMode::continuation
-                                    : analysis::SweepMode::independent;
-  o.upward = f.directions != "down";
-  o.downward = f.directions != "up";
-  o.point = f.point.settings(model.dofs());
-  std::string why;
-  if (!o.is_valid(&why)) throw InputError(why);
-  return o;
-}
-
 // What the bifurcation diagram draws: the first recorded component of every Poincaré point,
 // with the points of one parameter value and direction that fall within 1/1000 of the plotted
 // range of each other (under a pixel) kept once (a periodic orbit's hundreds of returns are a few
@@ -72,8 +39,9 @@ void write_plotted_points(const analysis::SweepOptions& o,
   const double cell = hi > lo ? (hi - lo) / 1000.0 : 1.0;
   std::FILE* file = std::fopen(path.c_str(), "w");
   if (file == nullptr) throw Error(fmt::format("cannot write {}", path));
-  fmt::print(file, "{},direction,index,period_index,value\n",
-             analysis::parameter_name(o.parameter));
+  const bool crossings = !o.point.section.stroboscopic();
+  fmt::print(file, "{},direction,index,{},value\n", analysis::parameter_name(o.parameter),
+             crossings ? "t" : "period_index");
   for (const auto& [id, r] : records) {
     const int index = static_cast<int>(id % o.points);
     std::set<long long> seen;
@@ -81,8 +49,17 @@ void write_plotted_points(const analysis::SweepOptions& o,
       const double y =
           r.poincare[static_cast<std::size_t>(k) * static_cast<std::size_t>(r.columns)];
       if (!std::isfinite(y) || !seen.insert(std::llround((y - lo) / cell)).second) continue;
-      fmt::print(file, "{:.17g},{},{},{},{:.17g}\n", o.value(index), id < o.points ? "up" : "down",
-                 index, o.point.transient_periods + k + 1, y);
+      if (crossings) {
+        const std::size_t row = static_cast<std::size_t>(k);
+        fmt::print(file, "{:.17g},{},{},{:.17g},{:.17g}\n", o.value(index),
+                   id < o.points ? "up" : "down", index,
+                   row < r.section_times.size() ? r.section_times[row]
+                                                : std::numeric_limits<double>::quiet_NaN(),
+                   y);
+      } else {
+        fmt::print(file, "{:.17g},{},{},{},{:.17g}\n", o.value(index),
+                   id < o.points ? "up" : "down", index, o.point.transient_periods + k + 1, y);
+      }
     }
   }
   if (std::fclose(file) != 0) throw Error(fmt::format("cannot finish writing {}", path));
@@ -120,6 +97,29 @@ void sweep(const SweepFlags& f) { run_sweep(sweep_options(f), f.run, f.branches)
 
 }  // namespace
 
+analysis::SweepOptions sweep_options(const SweepFlags& f) {
+  analysis::SweepOptions o;
+  const analysis::PointModel model = f.model.model();
+  if (model.explicit_structure()) {
+    o.structure = model.structure();
+  } else {
+    o.chain = model.chain();
+  }
+  o.parameter = parse_model_parameter(model, "--parameter", f.parameter);
+  parse_range("--range", f.range, &o.from, &o.to);
+  o.points = f.points;
+  o.mode = f.mode == "continuation" ? analysis::SweepMode::continuation
+                                    : analysis::SweepMode::independent;
+  o.upward = f.directions != "down";
+  o.downward = f.directions != "up";
+  o.point = f.point.settings(model.dofs());
+  o.point.section = f.section.poincare_section(model.dofs());
+  if (!f.start.at_rest()) o.initial_state = f.start.state(model.dofs());
+  std::string why;
+  if (!o.is_valid(&why)) throw InputError(why);
+  return o;
+}
+
 void run_sweep(const analysis::SweepOptions& o, const RunFlags& run, const std::string& branches) {
   const std::string component =
       o.point.components.empty()
@@ -146,18 +146,46 @@ void run_sweep(const analysis::SweepOptions& o, const RunFlags& run, const std::
              fmt::format(
                  "poincare='{0}/bifurcation_points.csv'; classes='{0}/classification.csv'; "
                  "out='{0}/bifurcation.{4}'; column=5; xname='{1}'; "
-                 "yname='{2} at t = kT (nondimensional)'; title={3}",
+                 "yname='{2} at {5} (nondimensional)'; title={3}",
                  run.out, parameter_label(o.parameter), component,
                  gnuplot_quoted(fmt::format(
                      "pwl sweep of {} ({}): {}", analysis::parameter_name(o.parameter),
                      o.mode == analysis::SweepMode::continuation ? "continuation" : "independent",
                      study_title(o.model(), o.point))),
-                 format);
+                 format, o.point.section.label(o.model().dofs()));
     };
     draw_figure_and_report(scripts_directory() + "/bifurcation.gp", definitions,
                            run.out + "/bifurcation", "pwl sweep", false);
   };
   run_study(study, run);
+}
+
+void add_sweep_flags(CLI::App& c, SweepFlags& flags) {
+  add_model_flags(c, flags.model);
+  c.add_option("--parameter", flags.parameter,
+               "Parameter swept: theta, alpha, zeta, gap (Δ̃) or amplitude (scales Q) of the\n"
+               "chain; spring<j>.stiffness, spring<j>.gap, load<j>.amplitude, load<j>.frequency\n"
+               "or damping (scales C) of a --structure-scene (j from 1)");
+  c.add_option("--range", flags.range, "FROM:TO, from < to");
+  c.add_option("--points", flags.points, "Number of parameter values N");
+  c.add_option("--mode", flags.mode,
+               "independent (every point from rest, or from --x0/--v0) or continuation (from the\n"
+               "previous point's final state, upward and downward; each branch's first point\n"
+               "from rest or --x0/--v0)")
+      ->check(CLI::IsMember({"independent", "continuation"}));
+  c.add_option("--directions", flags.directions, "Continuation branches: both, up or down")
+      ->check(CLI::IsMember({"both", "up", "down"}));
+  add_point_flags(c, flags.point, true);
+  add_section_flags(c, flags.section,
+                    "poincare.csv (t, the crossing time, instead\n"
+                    "of period_index for a hyperplane) and the diagram get the section's points of\n"
+                    "--record's components");
+  add_initial_state_flags(c, flags.start);
+  add_run_flags(c, flags.run);
+  c.add_option("--branches", flags.branches,
+               "Also draw the periodic-orbit branches of a pwl continue folder (its\n"
+               "branch_section.csv: stable filled, unstable open) over the diagram's points")
+      ->check(CLI::ExistingDirectory);
 }
 
 void add_sweep_command(CLI::App& app) {
@@ -169,25 +197,7 @@ void add_sweep_command(CLI::App& app) {
       "           --mode continuation --out theta_sweep\n"
       "         pwl sweep --structure-scene apps/scenes/two_mass_stop.toml \\\n"
       "           --parameter spring1.gap --range 0.05:0.5 --points 50 --out gap_sweep");
-  add_model_flags(*c, flags->model);
-  c->add_option("--parameter", flags->parameter,
-                "Parameter swept: theta, alpha, zeta, gap (Δ̃) or amplitude (scales Q) of the\n"
-                "chain; spring<j>.stiffness, spring<j>.gap, load<j>.amplitude, load<j>.frequency\n"
-                "or damping (scales C) of a --structure-scene (j from 1)");
-  c->add_option("--range", flags->range, "FROM:TO, from < to");
-  c->add_option("--points", flags->points, "Number of parameter values N");
-  c->add_option("--mode", flags->mode,
-                "independent (every point from rest) or continuation (from the previous point's "
-                "final state, upward and downward)")
-      ->check(CLI::IsMember({"independent", "continuation"}));
-  c->add_option("--directions", flags->directions, "Continuation branches: both, up or down")
-      ->check(CLI::IsMember({"both", "up", "down"}));
-  add_point_flags(*c, flags->point, true);
-  add_run_flags(*c, flags->run);
-  c->add_option("--branches", flags->branches,
-                "Also draw the periodic-orbit branches of a pwl continue folder (its\n"
-                "branch_section.csv: stable filled, unstable open) over the diagram's points")
-      ->check(CLI::ExistingDirectory);
+  add_sweep_flags(*c, *flags);
   c->callback([flags] { sweep(*flags); });
 }
 

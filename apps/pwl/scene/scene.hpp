@@ -10,8 +10,10 @@
 //     name = "pim"                 # any --method; steps_per_period, dt, tol, locate_kinks, lcp
 //     [run]
 //     periods = 1000
+//     x0 = [0.1, 0, 0, 0, 0]       # the initial state (--x0, --v0; one value is every mass's)
 //     [analysis]
 //     transient = 500
+//     section = "v3=0,down"        # --section: strobe (with phase = P) or a hyperplane
 //     [output]
 //     out = "out/fig4b"
 //

@@ -14,6 +14,7 @@
 // is reported once.
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "pwl/types.hpp"
@@ -65,6 +66,41 @@ std::vector<Crossing> find_crossings(const HyperplaneSection& section,
                                      const std::vector<Vector>& states,
                                      const std::vector<Vector>& derivatives = {});
 
+// The Poincaré section a job records, as the command line's --section and --phase give it.
+//
+// The stroboscopic section samples the state at t = (k + phase) T, k = 0, 1, ...: once per
+// forcing period T at a fixed phase of the loads (phase a fraction of T, 0 <= phase < 1). It is
+// the section of the period map, and the regime of a motion (period-k, quasi-periodic, chaotic),
+// λ1 and K are properties of that map: whichever section a job records, it classifies the motion
+// on the stroboscopic points at `phase`. A hyperplane section records, instead, every crossing of
+// state[component] = level in the chosen direction, whenever it happens (v_i = 0 going down: the
+// largest excursions of mass i); it changes which points are recorded, written and drawn, not the
+// classification.
+struct PoincareSection {
+  enum class Kind { stroboscopic, hyperplane };
+  Kind kind = Kind::stroboscopic;
+  double phase = 0.0;            // of the stroboscopic points, in [0, 1)
+  HyperplaneSection hyperplane;  // when kind == hyperplane
+
+  bool stroboscopic() const { return kind == Kind::stroboscopic; }
+  // The stroboscopic section at phase 0 (t = kT), what every job records unless told otherwise.
+  bool is_default() const { return stroboscopic() && phase == 0.0; }
+  // Ceres-style check for a state of 2 `dofs` components: false with a message naming the field
+  // and its value (a phase outside [0, 1), a component out of range, a level that is not finite).
+  bool is_valid(Index dofs, std::string* why) const;
+  // The command line's spelling: "strobe", or the hyperplane as "v3=0,down" (components named
+  // x1..xn, v1..vn for n = dofs; the level in its shortest exact decimal form).
+  std::string text(Index dofs) const;
+  // For figure labels and messages: "t = kT", "t = (k + 0.25)T", "v3 = 0 going down".
+  std::string label(Index dofs) const;
+};
+
+// The section named by `text`: "strobe", or "<c><i>=<level>,<direction>" with c = x (a
+// displacement) or v (a velocity), i = 1..dofs, a finite level and the direction up, down or both
+// ("v3=0,down", "x2=0.1,up"; blanks around the parts are ignored). The phase is left at 0. Throws
+// InputError saying what is wrong with the text (the caller names its flag and the value).
+PoincareSection parse_poincare_section(std::string_view text, Index dofs);
+
 // A mechanical state sample: displacements x and velocities v at time t, and optionally the
 // accelerations a (empty when not known).
 struct StateSample {
@@ -73,6 +109,14 @@ struct StateSample {
   Vector v;
   Vector a;
 };
+
+// The state at time t between two samples a and b (a.t < t < b.t; at either end, that sample),
+// by the interpolation stroboscopic_samples uses: displacements cubic-Hermite from x and v,
+// velocities cubic-Hermite from v and a when both samples carry accelerations (O(h^4)) and
+// otherwise the derivative of the displacement interpolant (O(h^3)), accelerations linearly when
+// present. The result's t is t. Throws InputError for samples of different sizes or t outside
+// [a.t, b.t].
+StateSample interpolate_state(const StateSample& a, const StateSample& b, double t);
 
 struct StroboscopicOptions {
   // A target time within snap_tolerance * (local step length) of a sample takes that sample

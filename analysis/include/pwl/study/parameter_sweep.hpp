@@ -8,7 +8,8 @@
 // runs upward (from `from` to `to`) and downward, each point starting from the final state of the
 // one before, so that the two directions follow different attractors where they coexist
 // (hysteresis). Each point keeps its Poincaré points of the chosen components and one
-// classification (sweep_point.hpp).
+// classification (sweep_point.hpp). The section of point.section decides which Poincaré points
+// are kept; the classification is always that of the stroboscopic map at its phase.
 //
 // Point ids: index i (0-based, value from + (to - from) i / (N - 1)) upward is id i, downward is
 // id N + i. Files are written sorted by direction (up first) and index, whatever order the
@@ -38,7 +39,9 @@ struct SweepOptions {
   bool upward = true;    // continuation: run the upward branch
   bool downward = true;  // continuation: run the downward branch
   PointSettings point;
-  Vector initial_state;  // [x; v]; empty: at rest
+  // [x; v]; empty: at rest. Every point of an independent sweep starts from it, and the first
+  // point of each branch of a continuation (and any point after one that blew up).
+  Vector initial_state;
 
   // The model the sweep varies: the chain or the explicit structure.
   PointModel model() const;
@@ -59,7 +62,8 @@ struct SweepOptions {
   Vector start_state() const;  // initial_state, or rest
 };
 
-// Writes <folder>/poincare.csv (parameter,direction,index,period_index,<component names>) and
+// Writes <folder>/poincare.csv (parameter,direction,index,period_index,<component names>; for a
+// hyperplane section t, the crossing's time, instead of period_index) and
 // <folder>/classification.csv (index,parameter,direction, then every indicator of indicators.hpp:
 // regime,code,period,lambda1,lambda1_error,K,...), sorted, with doubles at 17 significant digits. Throws pwl::Error when a file
 // cannot be written.

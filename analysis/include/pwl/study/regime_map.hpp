@@ -37,7 +37,10 @@ struct RegimeMapOptions {
   MapAxis first;              // horizontal axis (x of the figure)
   MapAxis second;             // vertical axis (y)
   SweepMode mode = SweepMode::independent;
-  PointSettings point;        // components are ignored: a map keeps no Poincaré points
+  // Components are ignored: a map keeps no Poincaré points. Its section must be the strobe (at
+  // any phase, the points each cell is classified on): a hyperplane would change nothing a map
+  // keeps, and is_valid refuses it.
+  PointSettings point;
   Vector initial_state;       // empty: at rest
 
   PointModel model() const;

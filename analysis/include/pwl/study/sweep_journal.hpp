@@ -9,8 +9,9 @@
 //
 // where the payload is the point's indicators in the order of their table (indicators.hpp; the
 // derived ones left out), then the number of columns and of values of its Poincaré points, the
-// values, the size of its final state and its entries, all separated by single blanks, and
-// the checksum is the 64-bit FNV-1a hash of the payload (Fowler, Noll & Vo; see
+// values, the size of its final state and its entries, for a hyperplane section the number of
+// its points' times and the times (left out when there are none), all separated by single
+// blanks, and the checksum is the 64-bit FNV-1a hash of the payload (Fowler, Noll & Vo; see
 // draft-eastlake-fnv) in hexadecimal. A reader trusts a line only when it ends with a newline,
 // parses completely and its checksum matches, so a torn or garbled line is dropped and its point
 // computed again. Doubles are written with 17 significant digits, which read back as the same

@@ -1,6 +1,6 @@
 #pragma once
 // The motion-analysis pipeline: one case integrated from a given state past its transient, its
-// stroboscopic Poincaré points recorded and its motion classified. `pwl sweep`, `pwl map` and
+// Poincaré points recorded and its motion classified. `pwl sweep`, `pwl map` and
 // `pwl analyze` all evaluate their points here, so the same case with the same settings gives the
 // same regime, period, λ1 and K whichever job asks.
 //
@@ -12,6 +12,14 @@
 // PointObserver, which sees the integrator, every step of the periods it asks for, every recorded
 // Poincaré point and the classification, without a second integration or a second classification.
 //
+// Sections. The regime, its period, λ1 and K are properties of the motion, defined on its
+// stroboscopic map: they are always classified on the points at t = (k + phase) T, the phase of
+// settings.section. What the section changes is which points are recorded (PointResult::poincare
+// and the observer's poincare_point): those same stroboscopic points for a stroboscopic section,
+// every crossing of the hyperplane during the recorded periods for a hyperplane one
+// (section_sampler.hpp says how both are sampled). The default, the strobe at phase 0, is what
+// every job did before sections were chosen, step for step.
+//
 // The result depends only on the case, the initial state and the settings: no clock, no thread,
 // no random seed that is not fixed here. That is what makes a serial, a multithreaded, a
 // distributed and a resumed study write identical files.
@@ -20,6 +28,7 @@
 #include <vector>
 
 #include "pwl/analysis/motion_classifier.hpp"
+#include "pwl/analysis/poincare_section.hpp"
 #include "pwl/integrators/integrator.hpp"
 #include "pwl/integrators/method_table.hpp"
 #include "pwl/study/point_model.hpp"
@@ -58,6 +67,9 @@ struct PointSettings {
   // 0-based state components kept in PointResult::poincare: 0..n-1 are x1..xn, n..2n-1 are
   // v1..vn. May be empty (a regime map keeps only the indicators).
   std::vector<int> components;
+  // The section recorded; its phase is also that of the stroboscopic points classified. Period k
+  // (1-based) of the integration ends at t = (k + phase) T.
+  PoincareSection section;
   int observable = -1;  // component the 0-1 test reads; -1: x of the last degree of freedom
   bool lyapunov = true;  // compute λ1 (at least 10 recorded periods)
   // The tangent estimates need a method with an exact tangent map (has_tangent_map()); with one
@@ -72,6 +84,8 @@ struct PointSettings {
   // Ceres-style check for a state of 2 `dofs` components: false with a message naming the field.
   bool is_valid(int dofs, std::string* why) const;
   // Every setting, one "key = value" per line in a fixed order (part of a study's description).
+  // The section and its phase are stated when they are not the default (the strobe at phase 0),
+  // so that the descriptions of studies from before sections existed read the same.
   std::string describe() const;
 };
 
@@ -86,7 +100,14 @@ struct PointResult {
 
   int columns = 0;              // = settings.components.size()
   std::vector<double> poincare; // recorded points x columns, row-major
-  Vector final_state;           // [x; v] at the end; empty when the motion blew up or failed
+  // The time of each recorded point of a hyperplane section (one per row, also when columns is
+  // 0); empty for a stroboscopic section, whose row k is the period transient + k + 1.
+  std::vector<double> section_times;
+  // [x; v] at a whole number of forcing periods after the record, where the loads are at phase 0
+  // again, so that the next point of a continuation starts where every point starts: the last
+  // stroboscopic point at phase 0, else the state at t = (transient + recorded + 1) T. Empty when
+  // the motion blew up or failed.
+  Vector final_state;
 
   int rows() const { return columns == 0 ? 0 : static_cast<int>(poincare.size()) / columns; }
 };
@@ -105,7 +126,8 @@ class PointObserver {
   // Before period k (1-based from the initial state) is integrated: what sees its steps (an
   // empty observer: nothing).
   virtual StepObserver steps_of_period(int /*k*/) { return {}; }
-  // Every recorded Poincaré point: period k, t = kT, the full state [x; v].
+  // Every recorded point of the section, the full state [x; v] at time t in period k: for a
+  // stroboscopic section t = (k + phase) T, for a hyperplane the crossing's time.
   virtual void poincare_point(int /*k*/, double /*t*/, const Vector& /*state*/) {}
   // Once, when the recorded points are classified (not for an unbounded or failed motion).
   virtual void classified(const Classification& /*classification*/,
@@ -113,8 +135,8 @@ class PointObserver {
 };
 
 // Integrates `point` from `initial_state` ([x; v], 2n; the loads start at phase 0) over
-// transient_periods + recorded_periods forcing periods and classifies the recorded ones: the period
-// search on the full state, λ1 over the recorded periods as settings.lyapunov_estimate says (the
+// transient_periods + recorded_periods forcing periods, records the section over the recorded ones
+// and classifies their stroboscopic points: the period search on the full state, λ1 over the recorded periods as settings.lyapunov_estimate says (the
 // first min(50, recorded/5) periods align the tangent vector or frame, the rest are averaged in
 // min(10, ...) blocks), and K on the observable when at least 100 points are recorded. A motion
 // that blows up is "unbounded" (not an exception). Throws InputError for invalid settings or state.

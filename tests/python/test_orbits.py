@@ -1,0 +1,88 @@
+"""pwl.orbit and pwl.continue_ against `pwl orbit` and `pwl continue`: the same orbit and
+multipliers as orbit.csv and floquet.csv, the same branch and bifurcations as branch.csv and
+bifurcations.csv, and the same errors."""
+
+import numpy as np
+import pytest
+
+import pwl
+from conftest import largest_difference, read_csv, state_matrix
+
+STATE = ["x1", "x2", "x3", "x4", "x5", "v1", "v2", "v3", "v4", "v5"]
+
+
+def test_orbit_equals_the_cli_files(cli):
+    # The unstable period-1 orbit inside figure 4a's period-2 motion.
+    o = pwl.orbit(figure="4a", period=1)
+    out = cli.out("orbit", "--figure", "4a", "--period", "1", "--no-path")
+    assert largest_difference(o.state, state_matrix(read_csv(out / "orbit.csv"), STATE)[0]) <= 1e-12
+    floquet = read_csv(out / "floquet.csv")
+    assert o.multipliers.dtype == np.complex128 and o.multipliers.shape == (10,)
+    assert largest_difference(o.multipliers.real, floquet["re"]) <= 1e-12
+    assert largest_difference(o.multipliers.imag, floquet["im"]) <= 1e-12
+    assert np.all(np.diff(np.abs(o.multipliers)) <= 1e-12)  # largest modulus first
+    assert o.verdict == "unstable" and not o.stable and o.unstable_count == 1
+    assert o.residual <= 1e-10 * max(1.0, np.abs(o.state).max())
+    assert o.method == "exact event-driven" and o.method_default
+    assert o.monodromy.shape == (10, 10)
+    assert np.allclose(np.sort_complex(np.linalg.eigvals(o.monodromy)),
+                       np.sort_complex(o.multipliers), atol=1e-10)
+
+
+def test_continuation_equals_the_cli_files(cli):
+    c = pwl.continue_(figure="4a", parameter="theta", range="0.9:1.1")
+    out = cli.out("continue", "--figure", "4a", "--parameter", "theta", "--range", "0.9:1.1",
+                  "--no-plot", "--quiet")
+    branch = read_csv(out / "branch.csv")
+    count = len(branch["parameter"])
+    assert count > 10 and c.parameter.shape == (count,)
+    for name in ("branch", "parameter", "period", "max_abs_multiplier", "unstable_multipliers"):
+        assert largest_difference(getattr(c, name), branch[name]) <= 1e-12, name
+    assert np.array_equal(c.stable, branch["stable"] == 1)
+    amplitude = state_matrix(branch, ["amplitude_x{}".format(i) for i in range(1, 6)])
+    assert largest_difference(c.amplitude, amplitude) <= 1e-12
+    assert largest_difference(c.state[:, :5], state_matrix(branch, STATE[:5])) <= 1e-12
+    found = read_csv(out / "bifurcations.csv")
+    b = c.bifurcations
+    assert len(b["type"]) == len(found["type"]) > 0
+    assert list(b["type"]) == list(found["type"])
+    assert "period-doubling" in list(b["type"])
+    assert largest_difference(b["parameter"], found["parameter"]) <= 1e-12
+    assert np.array_equal(b["branch"], found["branch"])
+    assert largest_difference(np.where(b["spring"] > 0, b["spring"], np.nan), found["spring"]) == 0
+    assert largest_difference(b["multiplier"].real, found["multiplier_re"]) <= 1e-12
+    assert largest_difference(b["multiplier"].imag, found["multiplier_im"]) <= 1e-12
+    assert [d for d in b["detail"]] == [d for d in np.char.strip(found["detail"].astype(str))]
+    assert c.notes and c.parameter_name == "theta"
+    assert pwl.continuation is pwl.continue_
+
+
+@pytest.mark.parametrize("job, flags, args", [
+    ("orbit", dict(period=0), ["--period", "0"]),
+    ("orbit", dict(shots=3, period=2), ["--shots", "3", "--period", "2"]),
+    ("continue", dict(figure="4a"), ["--figure", "4a"]),  # --parameter is required
+    ("continue", dict(parameter="theta", range="1:1"), ["--parameter", "theta", "--range", "1:1"]),
+    ("continue", dict(parameter="alpha", range="-1:2"),
+     ["--parameter", "alpha", "--range", "-1:2"]),
+])
+def test_bad_values_raise_input_error_with_the_cli_message(cli, job, flags, args):
+    function = pwl.continue_ if job == "continue" else pwl.orbit
+    with pytest.raises(pwl.InputError) as raised:
+        function(**flags)
+    assert str(raised.value) in cli.error(job, *args, "--out", cli.folder / "bad")
+
+
+def test_a_failed_newton_raises_run_error(cli):
+    with pytest.raises(pwl.RunError) as raised:
+        pwl.orbit(figure="4a", max_iterations=1, transient=0)
+    assert isinstance(raised.value, RuntimeError)
+    stderr = cli.run("orbit", "--figure", "4a", "--max-iterations", "1", "--transient", "0",
+                     "--out", cli.folder / "failed", code=1).stderr
+    assert str(raised.value) in stderr
+
+
+def test_file_keywords_are_refused():
+    with pytest.raises(TypeError, match="does not take over_sweep="):
+        pwl.continue_(parameter="theta", range="0.9:1.1", over_sweep=50)
+    with pytest.raises(TypeError, match="unexpected keyword argument 'guess'"):
+        pwl.orbit(guess=[0.0] * 10)
