@@ -31,4 +31,12 @@ class DivergenceError : public Error {
   using Error::Error;
 };
 
+// A computation spent the work budget it was given (the event-driven solver's switches or gap
+// evaluations in one call): the input is valid, but this method would take too long on it. The
+// message names the budget, how far the computation got and what to do instead.
+class BudgetError : public Error {
+ public:
+  using Error::Error;
+};
+
 }  // namespace pwl

@@ -3,6 +3,7 @@
 #include "pwl/integrators/event_driven_solver.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <complex>
 #include <cstdint>
@@ -50,6 +51,15 @@ bool EventDrivenOptions::is_valid(std::string* why) const {
     *why = fmt::format("max_events = {} must be at least 1", max_events);
     return false;
   }
+  if (max_gap_samples < 1) {
+    *why = fmt::format("max_gap_samples = {} must be at least 1", max_gap_samples);
+    return false;
+  }
+  if (!(progress_interval >= 0.0) || !std::isfinite(progress_interval)) {
+    *why = fmt::format("progress_interval = {} must be finite and >= 0 (seconds)",
+                       progress_interval);
+    return false;
+  }
   return exponential.is_valid(why);
 }
 
@@ -62,6 +72,7 @@ using event_detail::GapSample;
 
 constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
 constexpr int kBoundOrders = 8;  // derivative orders with precomputed bounds (exponential form)
+constexpr int kSettlePasses = 4;  // mode flips of the springs on their kinks before they rest there
 
 // What every mode shares: the structure in state-space pieces.
 struct Structure {
@@ -112,6 +123,28 @@ Matrix mode_state_matrix(const Structure& s, const Vector& kmask) {
   return H;
 }
 
+// A diagonal similarity D = diag(d_x, 1) that balances a state matrix H = [[0, I], [-M⁻¹K_A, -M⁻¹C]]
+// (the header's note 1): displacement i is scaled by its degree of freedom's own frequency,
+// d_i ≈ √((M⁻¹K_A)_ii), rounded to a power of two so that the scaling is exact (as LAPACK's xGEBAL
+// balances before every eigenvalue problem, after Parlett and Reinsch 1969). In the coordinates
+// (d_i x_i, x_i') a stiff contact is the skew block [[0, ω], [-ω, 0]]. A degree of freedom
+// without stiffness of its own takes the smallest frequency of the others (1 when none has one).
+Vector balancing(const Matrix& H, Index n) {
+  Vector d = Vector::Ones(2 * n);
+  double smallest = std::numeric_limits<double>::infinity();
+  for (Index i = 0; i < n; ++i) {
+    const double k = -H(n + i, i);
+    if (k > 0.0 && std::isfinite(k)) smallest = std::min(smallest, std::sqrt(k));
+  }
+  if (!std::isfinite(smallest)) return d;
+  for (Index i = 0; i < n; ++i) {
+    const double k = -H(n + i, i);
+    const double w = k > 0.0 && std::isfinite(k) ? std::sqrt(k) : smallest;
+    d[i] = std::exp2(std::round(std::log2(w)));
+  }
+  return d;
+}
+
 // The loads of a mode: the structure's groups plus the constant W_A K2_A Δ_A, which joins the
 // ω = 0 group.
 std::vector<Term> mode_terms(const Structure& s, const Vector& kmask) {
@@ -146,15 +179,17 @@ class ModalMode final : public Mode {
                                          std::string* why, double* condition) {
     auto mode = std::unique_ptr<ModalMode>(new ModalMode(s, signs));
     const Matrix H = mode_state_matrix(s, kmask);
-    Eigen::EigenSolver<Matrix> eig(H, true);
+    // The eigenvectors V_b of the balanced D H D⁻¹, mapped back: H = (D⁻¹ V_b) Λ (V_b⁻¹ D).
+    const Vector d = balancing(H, s.n);
+    Eigen::EigenSolver<Matrix> eig(d.asDiagonal() * H * d.cwiseInverse().asDiagonal(), true);
     if (eig.info() != Eigen::Success) {
       *why = "the eigenvalue iteration did not converge";
       return nullptr;
     }
     mode->lambda_ = eig.eigenvalues();
-    const ComplexMatrix V = eig.eigenvectors();
-    Eigen::PartialPivLU<ComplexMatrix> lu(V);
-    // cond(V) in the 1-norm, from the LU factors' estimate of the reciprocal condition number.
+    const ComplexMatrix Vb = eig.eigenvectors();
+    Eigen::PartialPivLU<ComplexMatrix> lu(Vb);
+    // cond(V_b) in the 1-norm, from the LU factors' estimate of the reciprocal condition number.
     const double rcond = lu.rcond();
     *condition = rcond > 0.0 ? 1.0 / rcond : std::numeric_limits<double>::infinity();
     if (!(*condition <= o.max_eigenvector_condition)) {
@@ -163,7 +198,8 @@ class ModalMode final : public Mode {
                          *condition, o.max_eigenvector_condition);
       return nullptr;
     }
-    mode->vinv_ = lu.inverse();
+    mode->vinv_ = lu.inverse() * d.cast<Complex>().asDiagonal();
+    const ComplexMatrix V = d.cwiseInverse().cast<Complex>().asDiagonal() * Vb;
     mode->v_ = V;
     const Index n = s.n;
     mode->gap_v_ = s.gap_rows.cast<Complex>() * V.topRows(n);
@@ -204,8 +240,16 @@ class ModalMode final : public Mode {
 
   void start(double t0, const Vector& v0) override {
     t0_ = t0;
-    c_ = vinv_ * v0.cast<Complex>();
-    for (const ModalTerm& t : terms_) c_ -= t.modal * std::polar(1.0, t.omega * t0);
+    // The homogeneous part starts from the real state less the real particular response, so c
+    // is conjugate-symmetric like the modes. (Less the complex response, c would also carry a
+    // part that moves only the discarded imaginary part, as large as that response's imaginary
+    // part in modal coordinates: 1e-5 against a real vibration of 1e-9 on a contact at α = 1e9,
+    // and every derivative bound, so every sample spacing, would pay for it.)
+    homogeneous_ = v0;
+    for (const ModalTerm& t : terms_) {
+      homogeneous_ -= (t.state * std::polar(1.0, t.omega * t0)).real();
+    }
+    c_ = vinv_ * homogeneous_.cast<Complex>();
   }
 
   void sample(const GapSample&, double t, GapSample& out) override {
@@ -331,7 +375,7 @@ class ModalMode final : public Mode {
   Matrix powers_;
   double t0_ = 0.0;
   ComplexVector c_, z_, lz_, llz_;
-  Vector g_, r_, a_, weights_;
+  Vector homogeneous_, g_, r_, a_, weights_;
   // The tangent map: the parts of V and V⁻¹ (set on first use) and 2n x p work space.
   Matrix v_re_, v_im_, vinv_re_, vinv_im_;
   Matrix modal_re_, modal_im_, scaled_re_;
@@ -368,18 +412,39 @@ class ExponentialMode final : public Mode {
       ++g;
     }
     h_ = Hh;
-    // Logarithmic 2-norm: ||exp(Ĥ u)|| <= exp(μ u).
-    Eigen::SelfAdjointEigenSolver<Matrix> sym(0.5 * (Hh + Hh.transpose()), Eigen::EigenvaluesOnly);
+    // Bounds and spacing in balanced coordinates D̂ w: the state balanced as the modal form is
+    // (balancing()), each load pair and the constant scaled so that its column is no longer
+    // than the state block's norm. Unbalanced, the logarithmic norm of [[0, I], [-ω², 0]] is
+    // about ω²/2, and exp(μ u) would force samples 1/ω² apart instead of 1/ω (5e-10 instead of
+    // 3e-5 at α = 1e9, for as long as a contact stays closed: the hours of issue 15).
+    scale_ = Vector::Ones(size_);
+    scale_.head(2 * n) = balancing(Hh.topLeftCorner(2 * n, 2 * n), n);
+    const auto balanced = [&] {
+      return Matrix(scale_.asDiagonal() * Hh * scale_.cwiseInverse().asDiagonal());
+    };
+    Matrix Hb = balanced();
+    const double norm = Hb.topLeftCorner(2 * n, 2 * n).lpNorm<Eigen::Infinity>();
+    for (Index c = 2 * n; c < size_; c += 2) {
+      const Index width = std::min<Index>(2, size_ - c);  // a sin/cos pair, or the constant
+      const double column = Hb.block(0, c, 2 * n, width).cwiseAbs().colwise().sum().maxCoeff();
+      if (norm > 0.0 && column > norm) {
+        scale_.segment(c, width).setConstant(std::exp2(std::ceil(std::log2(column / norm))));
+      }
+    }
+    balanced_h_ = balanced();
+    // Logarithmic 2-norm: ||D̂ exp(Ĥ u) w|| <= exp(μ u) ||D̂ w||.
+    Eigen::SelfAdjointEigenSolver<Matrix> sym(0.5 * (balanced_h_ + balanced_h_.transpose()),
+                                              Eigen::EigenvaluesOnly);
     log_norm_ = std::max(0.0, sym.eigenvalues().maxCoeff());
-    // Rows whose product with w is W^T times the displacement rows of Ĥ^r w.
+    // Rows whose product with D̂ w is W^T times the displacement rows of Ĥ^r w.
     Matrix rows = Matrix::Zero(s.m, size_);
-    rows.leftCols(n) = s.gap_rows;
+    rows.leftCols(n) = s.gap_rows * scale_.head(n).cwiseInverse().asDiagonal();
     row_norms_.resize(s.m, kBoundOrders + 1);
     for (int r = 0; r <= kBoundOrders; ++r) {
       row_norms_.col(r) = rows.rowwise().norm();
-      rows = rows * Hh;
+      rows = rows * balanced_h_;
     }
-    const double norm = Hh.topLeftCorner(2 * n, 2 * n).lpNorm<Eigen::Infinity>();
+    balanced_norm_ = balanced_h_.norm();
     double w_max = 0.0;
     for (double w : omegas_) w_max = std::max(w_max, w);
     spacing_ = 0.5 / std::max({norm, w_max, 1e-300});
@@ -413,13 +478,13 @@ class ExponentialMode final : public Mode {
 
   void derivative_bound(const GapSample& from, double span, int order, Vector& bound) override {
     const Vector& w = from.carry.size() == size_ ? from.carry : w0_;
-    const double growth = std::exp(log_norm_ * span) * w.norm();
+    const double growth = std::exp(log_norm_ * span) * w.cwiseProduct(scale_).norm();
     if (order <= kBoundOrders) {
       bound = row_norms_.col(order) * growth;
     } else {
-      // ||Ĥ^r|| <= ||Ĥ||^(r - kBoundOrders) times the stored rows.
+      // ||Ĥ_b^r|| <= ||Ĥ_b||^(r - kBoundOrders) times the stored rows (balanced).
       bound = row_norms_.col(kBoundOrders) * growth *
-              std::pow(h_.norm(), order - kBoundOrders);
+              std::pow(balanced_norm_, order - kBoundOrders);
     }
   }
 
@@ -443,10 +508,11 @@ class ExponentialMode final : public Mode {
   void apply_flow_jacobian(double delta, Matrix& tangent) override {
     if (!(delta > 0.0) || tangent.cols() == 0) return;
     const Index n2 = 2 * s_.n;
-    if (state_matrix_.size() == 0) state_matrix_ = h_.topLeftCorner(n2, n2);
+    if (state_matrix_.size() == 0) state_matrix_ = balanced_h_.topLeftCorner(n2, n2);
+    // exp(H δ) Y = D⁻¹ exp(D H D⁻¹ δ) D Y, D the state's part of D̂.
     const Matrix E = precise_exponential(state_matrix_, delta, exponential_);
-    product_.noalias() = E * tangent;
-    tangent = product_;
+    product_.noalias() = E * (scale_.head(n2).asDiagonal() * tangent);
+    tangent = scale_.head(n2).cwiseInverse().asDiagonal() * product_;
   }
   const Vector& start_state() const { return w0_; }
   double start_time() const { return t0_; }
@@ -456,13 +522,16 @@ class ExponentialMode final : public Mode {
     auto it = cache_.find(delta);
     if (it != cache_.end()) return it->second;
     if (cache_.size() > 256) cache_.clear();
+    // exp(Ĥδ) = D̂⁻¹ exp(D̂ Ĥ D̂⁻¹ δ) D̂: the 2^N algorithm on the balanced matrix, whose rounding
+    // is relative to each component's own scale.
     Matrix E;
     if (delta > 0.0) {
-      E = precise_exponential(h_, delta, exponential_);
+      E = precise_exponential(balanced_h_, delta, exponential_);
     } else {
       // Backwards (only ever by rounding amounts): exp(Ĥδ) = exp((-Ĥ)|δ|).
-      E = precise_exponential(Matrix(-h_), -delta, exponential_);
+      E = precise_exponential(Matrix(-balanced_h_), -delta, exponential_);
     }
+    E = scale_.cwiseInverse().asDiagonal() * E * scale_.asDiagonal();
     return cache_.emplace(delta, std::move(E)).first->second;
   }
 
@@ -472,6 +541,9 @@ class ExponentialMode final : public Mode {
   std::vector<double> omegas_;
   Index size_ = 0;
   Matrix h_;
+  Vector scale_;        // D̂
+  Matrix balanced_h_;   // D̂ Ĥ D̂⁻¹
+  double balanced_norm_ = 0.0;
   double log_norm_ = 0.0;
   Matrix row_norms_;
   double spacing_ = 1.0;
@@ -573,6 +645,11 @@ struct EventDrivenSolver::Impl {
     now = GapSample();
     now.t = time;
     mode->sample(now, time, now);
+    // The gaps and rates at the start are known exactly from the state; the mode's
+    // reconstruction differs by rounding, and a spring at rest on its kink would read
+    // e = ±1e-16 and be taken for clearly open or clearly closed.
+    now.e = signs.cwiseProduct(s.gap_rows * x - s.gaps);
+    now.rate = signs.cwiseProduct(s.gap_rows * v);
     x_scale = std::max({x_scale, x.cwiseAbs().maxCoeff(), mode->response_scale()});
   }
 
@@ -585,25 +662,48 @@ struct EventDrivenSolver::Impl {
   }
 
   // Springs on (or within rounding of) their kink at the current time get the mode their
-  // leading derivatives point to, and a certified departure time.
-  // A spring whose first significant derivative points back (it only touched its kink) is
-  // flipped back and certified again in the mode it came from.
+  // leading derivatives point to, and a certified departure time. A spring whose first
+  // significant derivative points back (it only touched its kink) is flipped back and certified
+  // again in the mode it came from. When both modes send it to the other (a derivative
+  // significant in one and below the threshold in the other, near a lift-off), the lower order
+  // decides: the first derivatives of a gap at its kink are the same in both modes. A spring
+  // still undecided after kSettlePasses flips rests on its kink (a rounding tolerance) for
+  // min_width.
   void settle(const std::vector<Index>& springs) {
     for (Index j : springs) resting[static_cast<std::size_t>(j)] = false;
-    for (int pass = 0; pass < 3; ++pass) {
+    // Per spring: the order that made it leave the first mode it was given (0: not flipped),
+    // and the order the two modes' verdicts settled on (0: none).
+    std::vector<int> left(springs.size(), 0), assumed(springs.size(), 0);
+    for (int pass = 0;; ++pass) {
       const Vector tol = tolerances();
       bool flipped = false;
-      for (Index j : springs) {
+      for (std::size_t i = 0; i < springs.size(); ++i) {
+        const Index j = springs[i];
         double until = t;
-        const int verdict = locator.certify_departure(gaps, now, j, tol[j],
-                                                            mode->nominal_spacing(),
-                                                            min_width(t), &until);
-        if (verdict < 0) {
+        int order = 0;
+        const auto certify = [&] {
+          return locator.certify_departure(gaps, now, j, tol[j], mode->nominal_spacing(),
+                                           min_width(t), &until, assumed[i], &order);
+        };
+        int verdict = certify();
+        if (verdict < 0 && left[i] > 0 && assumed[i] == 0) {
+          if (order < left[i]) {
+            assumed[i] = order;  // back to the first mode, certified there by this order
+          } else if (left[i] < order) {
+            assumed[i] = left[i];  // this mode, certified by the first mode's order
+            verdict = certify();
+          } else {
+            verdict = 0;  // the same order both ways: rounding; it rests on its kink
+            until = t + min_width(t);
+          }
+        }
+        if (verdict < 0 && pass < kSettlePasses) {
+          if (left[i] == 0) left[i] = std::max(order, 1);
           set_bit(j, !((mask >> j) & 1u));
           flipped = true;
         } else {
-          certified_until[j] = until;
-          resting[static_cast<std::size_t>(j)] = verdict == 0;
+          certified_until[j] = verdict > 0 ? until : t + min_width(t);
+          resting[static_cast<std::size_t>(j)] = verdict <= 0;
         }
       }
       if (!flipped) return;
@@ -718,15 +818,49 @@ void EventDrivenSolver::Impl::advance(double t_end, Matrix* tangent,
                                  "not before the current time {}",
                                  t_end, p.t));
   }
-  long events = 0;
+  // This call's work, against its budget, and its progress reports.
+  const double t_start = p.t;
+  const long events_before = p.diagnostics.events;
+  long crossings = 0, samples = 0;
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point wall_start = Clock::now();
+  const auto interval = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(p.options.progress_interval));
+  Clock::time_point next_report = wall_start + interval;
+  const auto report = [&](double t_now, long samples_now) {
+    const Clock::time_point wall = Clock::now();
+    if (wall < next_report) return;
+    next_report = wall + interval;
+    p.options.progress({t_now, t_start, t_end, p.diagnostics.events - events_before, samples_now,
+                        std::chrono::duration<double>(wall - wall_start).count()});
+  };
+  const auto spent = [&](const std::string& budget, const std::string& advice) {
+    std::string touching;
+    for (Index j = 0; j < p.s.m; ++j) {
+      if ((p.mask >> j) & 1u) touching += fmt::format("{}{}", touching.empty() ? "" : ", ", j + 1);
+    }
+    return BudgetError(fmt::format(
+        "event-driven solver: {} of one advance_to call is spent at t = {:.10g} (the call runs "
+        "from t = {:.10g} to t_end = {:.10g}): {} switches located ({} kept), {} gap "
+        "evaluations; touching now: {} (springs numbered from 1), sampled at least every {:.3g}. "
+        "{}",
+        budget, p.t, t_start, t_end, crossings, p.diagnostics.events - events_before, samples,
+        touching.empty() ? "none" : touching, p.mode->nominal_spacing(), advice));
+  };
+
   event_detail::SearchSettings settings;
+  if (p.options.progress) {
+    settings.tick = [&](double t_now, long s) { report(t_now, samples + s); };
+  }
   double segment_start = p.t;  // the tangent map: where the current mode's segment began
   while (true) {
     settings.nominal_spacing = p.mode->nominal_spacing();
     settings.min_width = p.min_width(t_end);
     settings.tolerance = p.tolerances();
     settings.certified_until = p.certified_until;
+    settings.max_samples = std::max<long>(p.options.max_gap_samples - samples, 1);
     const event_detail::SearchResult& r = p.locator.find_first_crossing(p.gaps, p.now, t_end, settings);
+    samples += r.samples;
     p.diagnostics.gap_samples += r.samples;
     p.diagnostics.uncertified += r.uncertified;
     p.mode->state(r.at, p.state);
@@ -737,6 +871,16 @@ void EventDrivenSolver::Impl::advance(double t_end, Matrix* tangent,
       p.mode->apply_flow_jacobian(p.t - segment_start, *tangent);
       segment_start = p.t;
     }
+    if (r.stopped) {
+      // No switch before r.at: the solver rests there, in a consistent state.
+      p.now = r.at;
+      throw spent(fmt::format("the budget max_gap_samples = {}", p.options.max_gap_samples),
+                  "Either the contacts are too stiff for event-driven integration at this "
+                  "scale (a closed contact is sampled at its own period) or the call is too "
+                  "long for the budget: use a fixed-step method (the switching PIM, "
+                  "pim-switching, at a step its guard accepts), raise max_gap_samples, or "
+                  "advance in shorter calls.");
+    }
     if (!r.found) {
       p.now = r.at;
       p.t = t_end;
@@ -744,12 +888,8 @@ void EventDrivenSolver::Impl::advance(double t_end, Matrix* tangent,
       if (observer) observer(p.t, p.x, p.v);
       return;
     }
-    if (++events > p.options.max_events) {
-      throw DivergenceError(fmt::format(
-          "event-driven solver: more than max_events = {} switches before t_end = {} (stuck at "
-          "t = {:.17g}: a Zeno or chattering motion)",
-          p.options.max_events, t_end, p.t));
-    }
+    ++crossings;
+    ++p.diagnostics.crossings;
     for (Index j : r.springs) p.set_bit(j, !((p.mask >> j) & 1u));
     p.enter(p.t);
     // Springs leaving their kink now, and those still inside an earlier departure window (the
@@ -773,6 +913,15 @@ void EventDrivenSolver::Impl::advance(double t_end, Matrix* tangent,
     }
     ++p.stats.steps;
     if (observer) observer(p.t, p.x, p.v);
+    if (crossings > p.options.max_events) {
+      throw spent(fmt::format("the budget max_events = {}", p.options.max_events),
+                  "Either the contacts switch too often for event-driven integration over "
+                  "this interval (chattering at a grazing contact, or contacts too stiff at "
+                  "this scale) or the call is too long for the budget: use a fixed-step "
+                  "method (the switching PIM, pim-switching), raise max_events, or advance in "
+                  "shorter calls.");
+    }
+    if (p.options.progress) report(p.t, samples);
   }
 }
 

@@ -35,6 +35,15 @@ void EventLocator::sample(const GapSample& from, double t, GapSample& out) {
   ++result_.samples;
 }
 
+// Ticks the caller's progress hook and reports whether the sample budget is spent.
+bool EventLocator::out_of_budget() {
+  if (s_->tick && result_.samples >= next_tick_) {
+    next_tick_ = result_.samples + SearchSettings::kTickSamples;
+    s_->tick(a_.t, result_.samples);
+  }
+  return s_->max_samples > 0 && result_.samples >= s_->max_samples;
+}
+
 GapSample& EventLocator::push() {
   if (top_ == stack_.size()) stack_.emplace_back();
   return stack_[top_++];
@@ -51,10 +60,12 @@ const SearchResult& EventLocator::find_first_crossing(ModeGaps& gaps, const GapS
   verdict_.assign(static_cast<std::size_t>(m_), Verdict::none);
   sign_only_.assign(static_cast<std::size_t>(m_), false);
   result_.found = false;
+  result_.stopped = false;
   result_.springs.clear();
   result_.samples = 1;
   result_.uncertified = 0;
   top_ = 0;
+  next_tick_ = SearchSettings::kTickSamples;
 
   for (Index j = 0; j < m_; ++j) {
     if (examined(j, start.t) && start.e[j] < -s_->tolerance[j]) result_.springs.push_back(j);
@@ -70,6 +81,12 @@ const SearchResult& EventLocator::find_first_crossing(ModeGaps& gaps, const GapS
     GapSample& first = push();
     sample(a_, propose(a_, t_end), first);
     while (top_ > 0) {
+      if (out_of_budget()) {
+        // a_ is certified: no spring crosses in (start.t, a_.t].
+        result_.stopped = true;
+        result_.at = a_;
+        return result_;
+      }
       GapSample& b = stack_[top_ - 1];
       const double width = b.t - a_.t;
       const double middle = a_.t + 0.5 * width;
@@ -223,18 +240,24 @@ void EventLocator::refine_one(Index j, const GapSample& a, GapSample& hi) {
 }
 
 int EventLocator::certify_departure(ModeGaps& gaps, const GapSample& at, Index spring,
-                                    double tol, double max_span, double min_width,
-                                    double* until) {
+                                    double tol, double max_span, double min_width, double* until,
+                                    int assumed_order, int* order) {
+  if (order != nullptr) *order = 0;
   if (at.e[spring] > tol) {
     *until = at.t;
     return 1;
   }
   double d[kDepartureOrders + 1];
   gaps.spring_derivatives(at, spring, kDepartureOrders, d);
-  for (int r = 1; r <= kDepartureOrders; ++r) {
-    const double size = gaps.spring_derivative_bound(at, 0.0, r, spring);
+  for (int r = std::max(assumed_order, 1); r <= kDepartureOrders; ++r) {
     const double value = d[r];
-    if (!(std::abs(value) > kSignificance * size)) continue;
+    // The assumed order is significant when it points to this side; otherwise it and the
+    // orders above it are judged against the bound of their size.
+    if (r != assumed_order || !(value > 0.0)) {
+      const double size = gaps.spring_derivative_bound(at, 0.0, r, spring);
+      if (!(std::abs(value) > kSignificance * size)) continue;
+    }
+    if (order != nullptr) *order = r;
     if (value < 0.0) return -1;
     // e(u) >= d_r u^r / r! - B u^(r+1) / (r+1)! (the lower derivatives are rounding): positive,
     // with half of the leading term to spare, for u <= (r+1) d_r / (2 B).

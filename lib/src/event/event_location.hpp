@@ -38,6 +38,7 @@
 // certify anything. The caller gives it a "certified_until" time from the leading derivatives
 // of its gap in the new mode (see certify_departure); no interval straddles that time, and
 // before it the spring is not examined.
+#include <functional>
 #include <vector>
 
 #include "pwl/types.hpp"
@@ -98,10 +99,19 @@ struct SearchSettings {
   double min_width = 0.0;        // narrower intervals are decided by their end signs
   Vector tolerance;              // tol_j
   Vector certified_until;        // spring j is not examined before this time
+  // A work budget: once this many gap evaluations are spent the search stops where it has
+  // certified that no spring crossed (SearchResult::stopped). 0: no limit.
+  long max_samples = 0;
+  // Called every kTickSamples gap evaluations with the time certified so far and the
+  // evaluations spent (progress reports of a long search); may be empty. What it throws
+  // leaves the search.
+  std::function<void(double t, long samples)> tick;
+  static constexpr long kTickSamples = 1024;
 };
 
 struct SearchResult {
   bool found = false;
+  bool stopped = false;        // max_samples spent: `at` is the last certified sample
   GapSample at;                // just past the first crossing, or at t_end
   std::vector<Index> springs;  // the springs that cross at `at`
   long samples = 0;            // gap evaluations spent
@@ -124,8 +134,18 @@ class EventLocator {
   // derivative is negative (the new mode is the wrong one: the spring only touched its kink), 0
   // when no derivative up to the sixth is significant (it rests on its kink;
   // *until = at.t + min_width).
+  //
+  // The first derivatives of a gap at its kink do not depend on the spring's own mode (its force
+  // vanishes there), but what counts as significant does: the bound of a derivative's size is
+  // larger in the mode where the spring is slack and its degree of freedom moves freely. So a
+  // derivative can be significant in one mode and below the threshold in the other, and each
+  // mode then sends the spring to the other. The caller settles that by the lower order (the
+  // event-driven solver's settle): `assumed_order` > 0 takes the derivative of that order as
+  // significant when it points to this mode's side, the lower orders as rounding; `order`, when
+  // not null, receives the order that decided (0: none did).
   int certify_departure(ModeGaps& gaps, const GapSample& at, Index spring, double tol,
-                        double max_span, double min_width, double* until);
+                        double max_span, double min_width, double* until,
+                        int assumed_order = 0, int* order = nullptr);
 
  private:
   enum class Verdict { none, single, unknown };
@@ -136,6 +156,7 @@ class EventLocator {
   void refine(const GapSample& a, const GapSample& b, GapSample& best);
   void refine_one(Index j, const GapSample& a, GapSample& hi);
   GapSample& push();
+  bool out_of_budget();
 
   ModeGaps* gaps_ = nullptr;
   const SearchSettings* s_ = nullptr;
@@ -146,6 +167,7 @@ class EventLocator {
   std::vector<bool> sign_only_;
   std::vector<GapSample> stack_;  // stack_[0..top_) are in use
   std::size_t top_ = 0;
+  long next_tick_ = 0;
   GapSample a_;
 };
 

@@ -17,6 +17,7 @@
 #include "pwl/integrators/banded_pim_integrator.hpp"
 #include "pwl/integrators/banded_step_operators.hpp"
 #include "pwl/errors.hpp"
+#include "pwl/integrators/step_guard.hpp"
 #include "integrators/fixed_step_count.hpp"
 #include "pwl/numerics/substructure_exponential.hpp"
 #include "pwl/numerics/state_checks.hpp"
@@ -102,17 +103,6 @@ std::vector<BandedMatrix> banded_force_coefficients(const GapStructure& s, doubl
   return out;
 }
 
-// max_i Σ_j |A_ij|.
-double infinity_norm(const RowSparse& A) {
-  double largest = 0.0;
-  for (Index i = 0; i < A.outerSize(); ++i) {
-    double sum = 0.0;
-    for (RowSparse::InnerIterator it(A, i); it; ++it) sum += std::abs(it.value());
-    largest = std::max(largest, sum);
-  }
-  return largest;
-}
-
 struct LoadTerm {
   double omega;
   Vector sin_part;  // M⁻¹ times the load's sin part
@@ -168,12 +158,9 @@ class BandedStepper final : public SwitchingPim,
                         g.cos_part.cwiseProduct(inverse_mass)});
     }
 
-    // η ω_max as the dense stepper bounds it (every spring touching).
-    const RowSparse k_all =
-        RowSparse(-stiffness_part_) - RowSparse(force_part_ * stiffnesses_.asDiagonal() * gap_rows_);
-    const double kn = infinity_norm(k_all);
-    const double cn = infinity_norm(damping_part_);
-    diagnostics_.step_argument = eta_ * 0.5 * (cn + std::sqrt(cn * cn + 4.0 * kn));
+    // η ω_max as the dense stepper and the step guard take it (contact_frequency: Gershgorin's
+    // bound beyond kDenseFrequencyDofs, O(nonzeros)).
+    diagnostics_.step_argument = eta_ * contact_frequency(s).omega_max;
     if ((d_ > 0 || end_derivative_) && diagnostics_.step_argument > o_.max_step_argument) {
       throw InputError(fmt::format(
           "pim.step = {}: η ω_max = {:.3g} exceeds max_step_argument = {} (the contact is too "

@@ -14,6 +14,7 @@
 #include "event/event_location.hpp"
 #include "switching/switching_pim_detail.hpp"
 #include "pwl/errors.hpp"
+#include "pwl/integrators/step_guard.hpp"
 #include "integrators/fixed_step_count.hpp"
 #include "pwl/numerics/block_pivoting.hpp"
 #include "pwl/numerics/lcp_solver.hpp"
@@ -162,12 +163,9 @@ Operators make_operators(const GapStructure& structure, const SwitchingPimOption
     ops.loads.push_back({g.omega, mass.solve(g.sin_part), mass.solve(g.cos_part)});
   }
 
-  // η ω_max with ω_max bounded from |λ|² <= ||M⁻¹K_all|| + |λ| ||M⁻¹C|| (every spring touching).
-  const Matrix k_all = -ops.stiffness_part -
-                       ops.force_part * ops.stiffnesses.asDiagonal() * ops.gap_rows;
-  const double kn = k_all.lpNorm<Eigen::Infinity>();
-  const double cn = ops.damping_part.lpNorm<Eigen::Infinity>();
-  ops.step_argument = o.step * 0.5 * (cn + std::sqrt(cn * cn + 4.0 * kn));
+  // η ω_max, ω_max the step guard's bound of |λ(H)| with every spring touching
+  // (contact_frequency, step_guard.hpp), so that a step the guard passes is one this accepts.
+  ops.step_argument = o.step * contact_frequency(structure).omega_max;
   if ((o.force_degree > 0 || o.end_derivative) && ops.step_argument > o.max_step_argument) {
     throw InputError(fmt::format(
         "step = {}: η ω_max = {:.3g} exceeds max_step_argument = {} (the contact is too stiff "

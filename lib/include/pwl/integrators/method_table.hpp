@@ -3,17 +3,19 @@
 //
 // A row says what a method is called (on the command line and in tables), what it can do and what
 // it needs: a fixed step grid, an exact tangent map (Lyapunov exponents, Floquet multipliers),
-// banded operators, an error tolerance, kink location, a size limit, its order of accuracy. The
-// command line's choices, the labels of tables and figures, the checks of a study's settings and
-// the factory all read this table, so adding an integrator is one file that implements it (with a
-// maker from MethodSettings), one enum value with its row here, and one test. Code that needs a capability asks the row (`method_traits(m)`)
-// or the integrator (`Integrator::method()`), never a name.
+// banded operators, an error tolerance, kink location, a size limit, its order of accuracy, the
+// step guard's limits on a fixed step (step_guard.hpp). The command line's choices, the labels
+// of tables and figures, the checks of a study's settings and the factory all read this table,
+// so adding an integrator is one file that implements it (with a maker from MethodSettings), one
+// enum value with its row here, and one test. Code that needs a capability asks the row
+// (`method_traits(m)`) or the integrator (`Integrator::method()`), never a name.
 #include <memory>
 #include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "pwl/integrators/event_driven_solver.hpp"
 #include "pwl/integrators/integrator.hpp"
 #include "pwl/integrators/method.hpp"
 #include "pwl/model/gap_structure.hpp"
@@ -49,6 +51,12 @@ struct MethodTraits {
                       // default force degree d = 2.
   long max_dofs;      // the largest structure it accepts (degrees of freedom); 0: no limit
   long max_springs;   // the most gap springs it accepts; 0: no limit
+  // The step guard (step_guard.hpp), fixed-grid rows only: limits on η ω_max (ω_max the highest
+  // frequency with every gap spring touching) beyond which a step draws a warning (the contact
+  // is under-resolved) and a refusal (the method misses contacts or blows up). 0: no step
+  // guard. The values and the measurements behind them are in method_table.cpp.
+  double step_warning;
+  double step_limit;
   IntegratorMaker make;
 };
 
@@ -75,6 +83,9 @@ struct MethodSettings {
   long band = 0;              // banded forms: a forced band q of the step operators, in degrees
                               // of freedom (0: the smallest q within the truncation tolerance)
   int force_degree = 2;       // switching forms: derivatives d of the load used (order d + 3)
+  // exact: the event-driven solver's options, among them its work budget per advance_to call
+  // (max_events, max_gap_samples) and the progress hook a program can print from.
+  EventDrivenOptions event_driven{};
 
   // Ceres-style check against the structure it will integrate: false with a message naming the
   // setting and its value (a step that is not positive, a tolerance that is not, a structure

@@ -122,7 +122,9 @@ struct SwitchingPimOptions {
   LcpAlgorithm lcp_solver = LcpAlgorithm::block_pivoting;
   PreciseExponentialOptions exponential;
   double divergence_bound = 1e12;
-  // Largest η ω_max allowed (ω_max: the largest |eigenvalue| of H with every spring touching).
+  // Largest η ω_max allowed (ω_max: the largest |eigenvalue| of H with every spring touching,
+  // as contact_frequency in step_guard.hpp bounds it; the method table's step guard refuses
+  // beyond the same 2).
   double max_step_argument = 2.0;
   // Pieces of a switching step whose series needs more terms than this are halved.
   int max_series_terms = 40;
