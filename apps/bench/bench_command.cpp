@@ -5,6 +5,7 @@
 //   pwl bench stability  where each method breaks as the contacts stiffen (accuracy_bench.hpp)
 //   pwl bench sweep      a θ sweep of the 5-DOF chain (bench_sweep.hpp)
 //   pwl bench orbits     periodic orbits by shooting against brute force, continuation (bench_orbits.hpp)
+//   pwl bench soak       a sweep killed at random and resumed, 20 times: the same files (bench_soak.hpp)
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -17,6 +18,7 @@
 #include "bench/bench_chain.hpp"
 #include "bench/bench_orbits.hpp"
 #include "bench/bench_scaling.hpp"
+#include "bench/bench_soak.hpp"
 #include "bench/bench_sweep.hpp"
 #include "bench/chain_figures.hpp"
 #include "pwl/errors.hpp"
@@ -33,7 +35,7 @@ void add_chain(CLI::App& bench) {
       "the dense PIM and dopri5, with the largest error of x1 and x1' against a reference\n"
       "Example: pwl bench chain --out out/bench\n"
       "         pwl run apps/scenes/paper_fig7-9_table1.toml   (the paper's methods, figures 7-9)");
-  c->add_option("--n", o->masses, "Number of masses")->check(CLI::Range(2, 100000000));
+  c->add_option("--n", o->masses, "Number of masses")->check(number_in(2, 100000000));
   c->add_option("--t-end", o->t_end, "End of the run (s)")->check(positive_number());
   c->add_option("--runs", o->runs, "Timed runs per method (median)")->check(positive_number());
   c->add_option("--dense-runs", o->dense_runs, "Timed runs of the dense PIM")
@@ -42,7 +44,8 @@ void add_chain(CLI::App& bench) {
   c->add_option("--wished-step", o->wished_step, "η1 given to the step rule (s)")
       ->check(positive_number());
   c->add_option("--rule-bands", o->rule_bands, "q given to the step rule, comma separated")
-      ->delimiter(',');
+      ->delimiter(',')
+      ->check(positive_number());
   c->add_option("--reference-tol", o->reference_tolerance, "Tolerance of the reference")
       ->check(positive_number());
   c->add_option("--reference-grid", o->reference_grid,
@@ -93,7 +96,9 @@ void add_scaling(CLI::App& bench) {
       "Time per step and peak memory of the banded PIM for n = 1000 ... 256000, beside the bare\n"
       "banded products of one step\n"
       "Example: pwl bench scaling --sizes 1000,4000,16000,64000,256000");
-  c->add_option("--sizes", o->sizes, "Numbers of masses, comma separated")->delimiter(',');
+  c->add_option("--sizes", o->sizes, "Numbers of masses, comma separated")
+      ->delimiter(',')
+      ->check(number_at_least(2));
   c->add_option("--step", o->step, "Step (s)")->check(positive_number());
   c->add_option("--steps", o->steps, "Timed steps per repeat")->check(positive_number());
   c->add_option("--repeats", o->repeats, "Repeats (median)")->check(positive_number());
@@ -102,6 +107,7 @@ void add_scaling(CLI::App& bench) {
   c->add_option("--out", o->out, "Folder for bench_scaling.csv");
   c->add_flag("--quiet", o->quiet, "Print only the table");
   c->add_option("--single", *single, "Internal: run one size and print one line")
+      ->check(naming("--single", non_negative_number()))
       ->group("");  // hidden
   c->callback([o, single, unshared] {
     o->share_rows = !*unshared;
@@ -131,6 +137,7 @@ void add_bench_command(CLI::App& app) {
   add_accuracy_benches(*bench);
   add_sweep_bench(*bench);
   add_orbits_bench(*bench);
+  add_soak_bench(*bench);
 }
 
 }  // namespace pwl::app

@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
+#include <csignal>
 #include <cstdio>
 #include <exception>
 #include <functional>
@@ -9,10 +10,15 @@
 #include <vector>
 
 #include "commands/commands.hpp"
+#include "parallel/stop_signals.hpp"
 #include "pwl/errors.hpp"
 #include "scene/scene_command_line.hpp"
 
 int main(int argc, char** argv) {
+  // A file size limit (ulimit -f) is met with SIGXFSZ, whose default action kills the process
+  // with no word; ignored, the write fails with EFBIG instead and becomes an error message that
+  // names the file, after the journal has been left with whole lines only.
+  std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{
       "pwl: vibration and bifurcation analysis of structures with gap-activated springs,\n"
       "by precise integration with one linear complementarity problem per step."};
@@ -49,6 +55,11 @@ int main(int argc, char** argv) {
     }
     const int code = app.exit(e);
     return code == 0 ? 0 : 2;
+  } catch (const pwl::app::Stopped& e) {
+    // A study stopped by SIGINT or SIGTERM, its journals whole: the exit code a shell reports for
+    // a process killed by that signal.
+    fmt::print(stderr, "pwl: {}\n", e.what());
+    return e.exit_code();
   } catch (const pwl::InputError& e) {
     fmt::print(stderr, "pwl: bad input: {}\n", pwl::app::locate_in_scene(e.what(), line));
     return 2;

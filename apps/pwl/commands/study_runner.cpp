@@ -3,17 +3,27 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
+#include <set>
 #include <sstream>
+#include <system_error>
 
 #include "commands/cli_checks.hpp"
 #include "commands/case_options.hpp"
+#include "commands/step_guard_report.hpp"
 #include "parallel/distributed.hpp"
+#include "parallel/stop_signals.hpp"
 #include "output/progress_bar.hpp"
 #include "pwl/integrators/method_table.hpp"
 #include "pwl/study/parameter_sweep.hpp"
@@ -121,6 +131,7 @@ void add_run_flags(CLI::App& c, RunFlags& f) {
   c.add_flag("--no-plot", f.no_plot, "Write the CSV files only");
   c.add_option("--threads", f.threads, "OpenMP threads (default: all cores)")
       ->check(non_negative_number());
+  add_force_flag(c, f.force);
 }
 
 void parse_range(const std::string& flag, const std::string& text, double* from, double* to) {
@@ -160,10 +171,18 @@ std::string first_difference(const std::string& recorded, const std::string& now
   }
 }
 
+// The format of the journals (sweep_journal.hpp), recorded in config.txt after the study's
+// description. A folder whose config.txt lacks it holds journals whose checksums leave the ids
+// out, which this version does not read.
+constexpr std::string_view kJournalFormat = "journal_format = 2\n";
+
 std::vector<fs::path> journal_files(const fs::path& folder) {
   std::vector<fs::path> files;
-  if (!fs::exists(folder)) return files;
-  for (const auto& entry : fs::directory_iterator(folder)) {
+  std::error_code ec;
+  if (!fs::exists(folder, ec)) return files;
+  fs::directory_iterator entries(folder, ec);
+  if (ec) throw Error(fmt::format("cannot list {}: {}", folder.string(), ec.message()));
+  for (const auto& entry : entries) {
     const std::string name = entry.path().filename().string();
     if (name.rfind("journal-", 0) == 0 && entry.path().extension() == ".log") {
       files.push_back(entry.path());
@@ -173,31 +192,144 @@ std::vector<fs::path> journal_files(const fs::path& folder) {
   return files;
 }
 
+// Writes `text` to `path` whole or not at all: into a file beside it, renamed over it once every
+// byte is written, so that a full disk leaves the old file as it was (a truncated config.txt would
+// make the folder refuse --resume). pwl::Error names the path and the system's reason.
+void write_whole_file(const fs::path& path, std::string_view text) {
+  const std::string target = path.string();
+  const std::string temporary = target + ".new";
+  const auto fail = [&](const char* what, int error) {
+    ::unlink(temporary.c_str());
+    return Error(fmt::format("cannot {} {}: {}", what, target, std::strerror(error)));
+  };
+  const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) {
+    const int error = errno;
+    throw Error(fmt::format("cannot write {}: {}", target, std::strerror(error)));
+  }
+  std::size_t written = 0;
+  while (written < text.size()) {
+    const ssize_t w = ::write(fd, text.data() + written, text.size() - written);
+    if (w < 0 && errno == EINTR) continue;
+    if (w < 0) {
+      const int error = errno;
+      ::close(fd);
+      throw fail("write", error);
+    }
+    written += static_cast<std::size_t>(w);
+  }
+  if (::close(fd) != 0) throw fail("write", errno);
+  if (::rename(temporary.c_str(), target.c_str()) != 0) throw fail("replace", errno);
+}
+
+// Refuses a folder in which no file can be created (read-only, not ours), naming the system's
+// reason, before any point is computed: a resumed run appends to journals that exist, which a
+// read-only folder allows, and would fail only when it writes the result files. (Result files that
+// exist and may be written would do without creating any; such a folder is refused all the same.)
+void check_folder_takes_files(const fs::path& folder) {
+  const std::string probe = (folder / fmt::format(".pwl-probe-{}", ::getpid())).string();
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0) {
+    const int error = errno;
+    throw Error(fmt::format("cannot create files in the output folder {}: {}", folder.string(),
+                            std::strerror(error)));
+  }
+  ::close(fd);
+  ::unlink(probe.c_str());
+}
+
+// A journal that could not be written: told apart from a point's own errors on the way out of
+// run_grid, to say what is kept.
+class JournalWriteError : public Error {
+ public:
+  using Error::Error;
+};
+
 void run_distributed(const Study& study, const RunFlags& flags, const Distributed& world) {
+  // SIGINT and SIGTERM stop the points from here to the end of the grid (stop_signals.hpp); the
+  // result files are written with the usual handlers back, as any other program writes files.
+  std::optional<StopSignals> signals(std::in_place);
+  // Before anything is written: a refused step costs nothing (every rank refuses alike).
+  guard_study_steps(study.tasks, study.case_of, study.settings, flags.force, world.rank() == 0);
   const fs::path folder(flags.out);
   const fs::path config = folder / "config.txt";
+  const std::string configuration = study.description + std::string(kJournalFormat);
+  bool resuming = false;
   // Every rank checks the recorded configuration, so that all of them refuse a mismatch alike.
-  if (flags.resume && fs::exists(config)) {
+  std::error_code ec;
+  if (flags.resume && fs::exists(config, ec)) {
     const std::string recorded = read_file(config);
-    if (recorded != study.description) {
-      throw InputError(fmt::format("--resume into {}: its configuration differs: {}", flags.out,
-                                   first_difference(recorded, study.description)));
+    if (recorded == study.description) {
+      throw InputError(fmt::format(
+          "--resume into {}: its journals are of an older format, whose checksums leave the point "
+          "ids out (config.txt has no \"{}\"); start over without --resume",
+          flags.out, kJournalFormat.substr(0, kJournalFormat.size() - 1)));
     }
+    if (recorded != configuration) {
+      throw InputError(fmt::format("--resume into {}: its configuration differs: {}", flags.out,
+                                   first_difference(recorded, configuration)));
+    }
+    resuming = true;
   }
   world.barrier();
   if (world.rank() == 0) {
-    fs::create_directories(folder);
-    if (!flags.resume || !fs::exists(config)) {
-      for (const fs::path& f : journal_files(folder)) fs::remove(f);
+    fs::create_directories(folder, ec);
+    if (ec) {
+      throw Error(fmt::format("cannot create the output folder {}: {}", flags.out, ec.message()));
     }
-    std::ofstream(config, std::ios::binary | std::ios::trunc) << study.description;
+    if (!fs::is_directory(folder, ec)) {
+      throw Error(fmt::format("the output folder {} exists and is not a folder", flags.out));
+    }
+    check_folder_takes_files(folder);
+    if (!resuming) {
+      for (const fs::path& f : journal_files(folder)) {
+        if (!fs::remove(f, ec) && ec) {
+          throw Error(fmt::format("cannot remove the old journal {}: {}", f.string(), ec.message()));
+        }
+      }
+      write_whole_file(config, configuration);
+    }
   }
   world.barrier();
   auto journal = std::make_unique<analysis::SweepJournal>(
       (folder / fmt::format("journal-{}.log", world.rank())).string(), true);
+  if (journal->cut_bytes() > 0) {
+    fmt::print(stderr,
+               "pwl: note: cut a torn last line of {} bytes off {}: a run was killed while writing "
+               "it; its point is computed again\n",
+               journal->cut_bytes(), journal->path());
+  }
   world.barrier();
-  std::map<long, analysis::PointResult> done;
-  for (const fs::path& f : journal_files(folder)) done.merge(analysis::read_journal(f.string()));
+  std::set<long> ids;
+  for (const analysis::GridTask& task : study.tasks) ids.insert(task.ids.begin(), task.ids.end());
+  std::vector<std::string> paths;
+  for (const fs::path& f : journal_files(folder)) paths.push_back(f.string());
+  const auto stop_asked = [] { return StopSignals::received() != 0; };
+  analysis::StudyJournals journals = analysis::read_study_journals(
+      paths, [&](long id) { return ids.count(id) > 0; }, stop_asked);
+  if (journals.stopped) {
+    // Told to stop while the journals were read: nothing was computed or written yet.
+    const int signal = StopSignals::received();
+    const std::string message = fmt::format(
+        "stopped by {} while reading the journals in {}, before computing anything; run the same "
+        "command with --resume to go on",
+        signal_name(signal), flags.out);
+    if (world.size() > 1) {
+      fmt::print(stderr, "pwl (rank {}): {}\n", world.rank(), message);
+      world.abort(128 + signal);
+    }
+    throw Stopped(signal, message);
+  }
+  std::map<long, analysis::PointResult> done = std::move(journals.records);
+  // Every rank reads every journal; one of them speaks.
+  if (world.rank() == 0) {
+    for (const std::string& w : journals.warnings) fmt::print(stderr, "pwl: warning: {}\n", w);
+    for (const std::string& n : journals.notes) fmt::print(stderr, "pwl: note: {}\n", n);
+    if (resuming) {
+      fmt::print(stderr, "resuming in {}: {} of {} points are journaled, {} to compute\n",
+                 flags.out, done.size(), ids.size(), ids.size() - done.size());
+    }
+  }
 
   std::vector<analysis::GridTask> mine;
   long todo = 0;
@@ -207,17 +339,56 @@ void run_distributed(const Study& study, const RunFlags& flags, const Distribute
     for (long id : study.tasks[t].ids) todo += done.count(id) == 0 ? 1 : 0;
   }
   std::string computed;
-  {
+  long journaled_here = 0;
+  analysis::GridEnd end = analysis::GridEnd::finished;
+  const long total = static_cast<long>(ids.size());
+  const auto journaled = [&] { return static_cast<long>(done.size()) + journaled_here; };
+  try {
     ProgressBar bar(todo, "points", !flags.quiet && world.rank() == 0);
-    analysis::run_grid(mine, study.case_of, study.initial_state, study.settings, done,
-                       [&](long id, const analysis::PointResult& r) {
-                         journal->append(id, r);
-                         if (world.size() > 1) computed += analysis::encode_record(id, r);
-                         bar.advance();
-                       },
-                       {flags.threads});
+    analysis::GridRun run;
+    run.threads = flags.threads;
+    run.stop = stop_asked;
+    end = analysis::run_grid(
+        mine, study.case_of, study.initial_state, study.settings, done,
+        [&](long id, const analysis::PointResult& r) {
+          try {
+            journal->append(id, r);
+          } catch (const Error& e) {
+            throw JournalWriteError(e.what());
+          }
+          ++journaled_here;
+          if (world.size() > 1) computed += analysis::encode_record(id, r);
+          bar.advance();
+        },
+        run);
+  } catch (const JournalWriteError& e) {
+    throw Error(fmt::format(
+        "{}; the {} of {} points journaled before are kept in {}: once it can be written, run "
+        "the same command with --resume to finish",
+        e.what(), journaled(), total, flags.out));
   }
+  const int signal = StopSignals::received();
+  signals.reset();
   journal.reset();
+  if (end == analysis::GridEnd::stopped || signal != 0) {
+    const long left = total - journaled();
+    const std::string message = fmt::format(
+        "stopped by {}: {} of {} points are done and journaled in {}; run the same command with "
+        "--resume to {}",
+        signal_name(signal), journaled(), total, flags.out,
+        left > 0 ? fmt::format("compute the other {}", left) : std::string("write the result files"));
+    if (world.size() > 1) {
+      // The other processes would wait for this one at the gathering below: end them all. What
+      // they journaled in this run is theirs to count, so this one tells its own.
+      fmt::print(stderr,
+                 "pwl (rank {}): stopped by {}: this process journaled {} points in {} in this run "
+                 "(of {} that were left); run the same command with --resume to finish\n",
+                 world.rank(), signal_name(signal), journaled_here, flags.out,
+                 total - static_cast<long>(done.size()));
+      world.abort(128 + signal);
+    }
+    throw Stopped(signal, message);
+  }
   const std::vector<std::string> gathered = world.gather(computed);
   if (world.rank() != 0) return;
   // Rank 0's journal holds its own points; the others' come from the gathered records, so that
@@ -241,7 +412,22 @@ void run_distributed(const Study& study, const RunFlags& flags, const Distribute
       records.emplace(id, found->second);
     }
   }
-  study.finish(records);
+  // The result files may not fit where the journals did: say that nothing is lost.
+  const std::string kept = fmt::format(
+      "every point is journaled in {}: once it can be written, run the same command with "
+      "--resume to write the result files",
+      flags.out);
+  try {
+    study.finish(records);
+  } catch (const InputError&) {
+    throw;
+  } catch (const Error& e) {
+    throw Error(fmt::format("{}; {}", e.what(), kept));
+  } catch (const std::system_error& e) {
+    // A write refused on the way (fmt::print on a full disk), whose message names no file.
+    throw Error(fmt::format("cannot write the result files in {}: {}; {}", flags.out,
+                            e.code().message(), kept));
+  }
 }
 
 }  // namespace
@@ -264,7 +450,8 @@ void run_study(const Study& study, const RunFlags& flags) {
   }
 }
 
-std::map<long, analysis::PointResult> compute_study(const Study& study, int threads) {
+std::map<long, analysis::PointResult> compute_study(const Study& study, int threads, bool force) {
+  guard_study_steps(study.tasks, study.case_of, study.settings, force);
   std::map<long, analysis::PointResult> records;
   analysis::run_grid(study.tasks, study.case_of, study.initial_state, study.settings, {},
                      [&](long id, const analysis::PointResult& r) { records.emplace(id, r); },

@@ -8,6 +8,18 @@
 // sorted result files. With --resume, a run whose config.txt matches skips the points already
 // in the journals; a different configuration is refused. Without it the folder is started over.
 //
+// Faults lose nothing that was finished (every message names the path and the system's reason):
+//  - damaged journal lines are warned about by file and line number and their points computed
+//    again; records that cannot belong to the study are refused (sweep_journal.hpp says which);
+//  - a folder in which no file can be created is refused before any point is computed;
+//  - a journal that stops taking lines (a full disk, a file size limit) keeps whole lines only, and
+//    the run ends with an error saying how many points are kept; result files that do not fit
+//    end it the same way with every point kept, for --resume to write them;
+//  - SIGINT and SIGTERM stop the points on every thread within a forcing period
+//    (parallel/stop_signals.hpp, GridRun::stop), keep the journals whole and end the run with
+//    Stopped (exit code 130 or 143) saying how many points are done and how to go on. Under
+//    mpirun the stopped rank ends them all (MPI_Abort with that code).
+//
 // Distributed runs (mpirun -np R): task t goes to rank t mod R, each rank spreads its tasks over
 // its OpenMP threads and journals them, and rank 0 gathers every record and writes the files, the
 // same bytes a single process writes. --resume needs the folder on a filesystem every rank sees.
@@ -68,6 +80,7 @@ struct RunFlags {
   bool quiet = false;
   bool no_plot = false;
   int threads = 0;
+  bool force = false;  // run points the step guard refuses (step_guard_report.hpp)
 };
 void add_run_flags(CLI::App& command, RunFlags& flags);
 
@@ -94,14 +107,18 @@ Study study_of(const GridOptions& o) {
   return study;
 }
 
-// Runs the study into flags.out. Throws InputError for a resume that does not match.
+// Runs the study into flags.out. Throws InputError for a resume that does not match or journals
+// that cannot be trusted, Stopped (stop_signals.hpp) on SIGINT or SIGTERM, Error for a folder or
+// a file that cannot be written.
 void run_study(const Study& study, const RunFlags& flags);
 
 // Computes every point of `study` in this process and returns the records by id (what `finish`
 // would get), with no folder, journal, progress bar or MPI: how an embedding runs a sweep or a
-// map in memory. `threads` as --threads (0: the OpenMP default). Throws what evaluate_point
-// throws (InputError for invalid settings).
-std::map<long, analysis::PointResult> compute_study(const Study& study, int threads = 0);
+// map in memory. `threads` as --threads (0: the OpenMP default), `force` as --force. Throws the
+// step guard's refusal (step_guard_report.hpp) and what evaluate_point throws (InputError for
+// invalid settings).
+std::map<long, analysis::PointResult> compute_study(const Study& study, int threads = 0,
+                                                    bool force = false);
 
 // Parses a range "a:b" into its ends; throws InputError naming the flag otherwise.
 void parse_range(const std::string& flag, const std::string& text, double* from, double* to);

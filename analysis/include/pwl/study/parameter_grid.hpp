@@ -32,15 +32,27 @@ using PointSink = std::function<void(long id, const PointResult& result)>;
 
 struct GridRun {
   int threads = 0;  // OpenMP threads; 0: the OpenMP default
+  // Asked, from any thread, before every point and between the forcing periods of every point
+  // (through PointObserver::steps_of_period); once it answers true, every thread leaves the point
+  // it is computing unfinished (the sink never sees it) and run_grid returns GridEnd::stopped.
+  // How a run stops at once on a signal: it must be cheap and thread-safe (an atomic flag read).
+  // Null: never stop.
+  std::function<bool()> stop = nullptr;
+};
+
+enum class GridEnd {
+  finished,  // every point of the tasks is in `done` or went to the sink
+  stopped,   // run.stop said so; the points that went to the sink are the only ones finished
 };
 
 // Computes every point of `tasks` that is not in `done`. A continuation that meets a point in
 // `done` takes its final state from there (a resumed run continues where the killed one stopped);
 // after a point whose motion blew up (no final state) it restarts from `initial_state`.
-// Exceptions from a point (bad input) are rethrown on the calling thread after the loop.
-void run_grid(const std::vector<GridTask>& tasks, const PointCaseOf& case_of,
-              const Vector& initial_state, const PointSettings& settings,
-              const std::map<long, PointResult>& done, const PointSink& sink,
-              const GridRun& run = {});
+// Exceptions from a point (bad input) or from the sink (a journal that cannot be written) stop
+// the other threads as run.stop does and are rethrown on the calling thread after the loop.
+GridEnd run_grid(const std::vector<GridTask>& tasks, const PointCaseOf& case_of,
+                 const Vector& initial_state, const PointSettings& settings,
+                 const std::map<long, PointResult>& done, const PointSink& sink,
+                 const GridRun& run = {});
 
 }  // namespace pwl::analysis
