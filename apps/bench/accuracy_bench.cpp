@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <limits>
 
+#include "commands/cli_checks.hpp"
 #include "output/csv_writer.hpp"
 #include "output/gnuplot.hpp"
 #include "pwl/errors.hpp"
@@ -454,13 +455,19 @@ void add_accuracy_benches(CLI::App& bench) {
       "Work-precision diagrams: error against CPU time for every method, with measured orders\n"
       "Example: pwl bench accuracy --case 4a --repeats 5");
   c->add_option("--case", options->cases, "Cases: 4a, chain (default both)")->delimiter(',');
-  c->add_option("--periods", options->periods, "Figure 4a: forcing periods from rest");
-  c->add_option("--repeats", options->repeats, "Timed runs per point (median reported)");
-  c->add_option("--budget", options->budget, "CPU seconds of repeats per point (>= 1 run)");
-  c->add_option("--chain-masses", options->chain_masses, "Chain: number of masses");
-  c->add_option("--chain-time", options->chain_time, "Chain: end time in seconds");
+  c->add_option("--periods", options->periods, "Figure 4a: forcing periods from rest")
+      ->check(positive_number());
+  c->add_option("--repeats", options->repeats, "Timed runs per point (median reported)")
+      ->check(positive_number());
+  c->add_option("--budget", options->budget, "CPU seconds of repeats per point (>= 1 run)")
+      ->check(positive_number());
+  c->add_option("--chain-masses", options->chain_masses, "Chain: number of masses")
+      ->check(number_at_least(2));
+  c->add_option("--chain-time", options->chain_time, "Chain: end time in seconds")
+      ->check(number_at_least(1));
   c->add_option("--chain-truth-tol", options->chain_truth_tolerance,
-                "Chain: tolerance of the kink-located rkf78 taken as the truth");
+                "Chain: tolerance of the kink-located rkf78 taken as the truth")
+      ->check(number_between(0, 1e-4));
   c->add_option("--out", options->out, "CSV folder (default plots/data/accuracy)");
   c->add_option("--plots", options->plots, "PNG and SVG folder (default plots/figures)");
   c->add_flag("--quick", options->quick, "Fewer points and shorter runs (a smoke test)");

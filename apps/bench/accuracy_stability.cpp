@@ -9,6 +9,7 @@
 #include <map>
 
 #include "bench/accuracy_bench.hpp"
+#include "commands/cli_checks.hpp"
 #include "output/csv_writer.hpp"
 #include "output/gnuplot.hpp"
 #include "pwl/analysis/period_detection.hpp"
@@ -345,17 +346,27 @@ void add_stability_bench(CLI::App& bench) {
       "stability",
       "Stability and failure chart: contact stiffness ratio against step or tolerance\n"
       "Example: pwl bench stability --quick");
-  c->add_option("--alpha", options->alphas, "Contact stiffness ratios k2/k1")->delimiter(',');
+  c->add_option("--alpha", options->alphas, "Contact stiffness ratios k2/k1")
+      ->delimiter(',')
+      ->check(positive_number());
   c->add_option("--steps", options->steps, "Fixed-step methods: steps per forcing period")
-      ->delimiter(',');
-  c->add_option("--tol", options->tolerances, "Runge-Kutta tolerances")->delimiter(',');
-  c->add_option("--periods", options->periods, "Forcing periods from rest");
+      ->delimiter(',')
+      ->check(positive_number());
+  c->add_option("--tol", options->tolerances, "Runge-Kutta tolerances")
+      ->delimiter(',')
+      ->check(positive_number());
+  c->add_option("--periods", options->periods, "Forcing periods from rest")
+      ->check(positive_number());
   c->add_option("--regime-points", options->regime_points,
-                "Last Poincaré points used to judge the regime (period)");
-  c->add_option("--target", options->target, "Error whose cost is reported");
+                "Last Poincaré points used to judge the regime (period)")
+      ->check(positive_number());
+  c->add_option("--target", options->target, "Error whose cost is reported")
+      ->check(positive_number());
   c->add_option("--accuracy-periods", options->accuracy_periods,
-                "Periods over which the error and its cost are measured");
-  c->add_option("--repeats", options->repeats, "Timed runs per cell (median reported)");
+                "Periods over which the error and its cost are measured")
+      ->check(positive_number());
+  c->add_option("--repeats", options->repeats, "Timed runs per cell (median reported)")
+      ->check(positive_number());
   c->add_option("--out", options->out, "CSV folder (default plots/data/stability)");
   c->add_option("--plots", options->plots, "PNG and SVG folder (default plots/figures)");
   c->add_flag("--quick", options->quick, "A coarse grid and short runs (a smoke test)");

@@ -733,8 +733,8 @@ void add_orbits_bench(CLI::App& bench) {
       ->check(non_negative_number());
   c->add_option("--sizes", o->sizes, "Masses of the medium and the large chain")
       ->delimiter(',')
-      ->check(CLI::Range(2, 1000000));
-  c->add_option("--points", o->points, "Continuation points per branch")->check(CLI::Range(2, 100000));
+      ->check(number_in(2, 1000000));
+  c->add_option("--points", o->points, "Continuation points per branch")->check(number_in(2, 100000));
   c->add_option("--cases", o->cases,
                 "Only these: 4a, 4a-stable, medium, large, continue-5, continue-medium")
       ->delimiter(',');

@@ -250,7 +250,7 @@ void add_sweep_bench(CLI::App& bench) {
   c->add_option("--points", o->points, "Points of the θ sweep")->check(positive_number());
   c->add_option("--transient", o->transient, "Transient periods per point")
       ->check(non_negative_number());
-  c->add_option("--periods", o->periods, "Recorded periods per point")->check(CLI::Range(100, 1000000));
+  c->add_option("--periods", o->periods, "Recorded periods per point")->check(number_in(100, 1000000));
   c->add_option("--repeats", o->repeats, "Timed runs (median)")->check(positive_number());
   c->add_option("--dopri5-every", o->dopri5_every, "dopri5 on every k-th point")
       ->check(positive_number());

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "analysis/point_checks.hpp"
@@ -73,6 +74,74 @@ bool find_unbounded(const std::vector<Vector>& points, const std::vector<double>
   return false;
 }
 
+// Least-squares slope of y on x.
+double slope(const std::vector<double>& x, const std::vector<double>& y, std::size_t from,
+             std::size_t to) {
+  const double n = static_cast<double>(to - from);
+  double mx = 0.0, my = 0.0;
+  for (std::size_t i = from; i < to; ++i) mx += x[i], my += y[i];
+  mx /= n;
+  my /= n;
+  double sxy = 0.0, sxx = 0.0;
+  for (std::size_t i = from; i < to; ++i) {
+    sxy += (x[i] - mx) * (y[i] - my);
+    sxx += (x[i] - mx) * (x[i] - mx);
+  }
+  return sxx > 0.0 ? sxy / sxx : 0.0;
+}
+
+// What rule 4a measured: the envelope of the amplitude block by block and its power of t.
+struct Growth {
+  bool ran = false;            // enough points to test
+  bool growing = false;        // the verdict
+  double exponent = 0.0;       // over the whole record
+  double late_exponent = 0.0;  // over its second half
+  double rise = 0.0;           // log(E_last / E_first)
+  bool monotone = false;       // the envelope rises in every block
+  int blocks = 0;
+  double first = 0.0, last = 0.0;            // E_0 and E_last
+  double first_time = 0.0, last_time = 0.0;  // their times
+};
+
+// Rule 4a (see the header): the envelope of |p_i| over equal blocks, its rise and its power of t.
+Growth measure_growth(const std::vector<Vector>& points, double first_point_time,
+                      const ClassifierOptions& options) {
+  Growth g;
+  const std::size_t n = points.size();
+  const auto blocks = static_cast<std::size_t>(options.growth_blocks);
+  if (!options.detect_growth || n < 4 * blocks) return g;
+  g.ran = true;
+  g.blocks = options.growth_blocks;
+  std::vector<double> r(n);
+  for (std::size_t i = 0; i < n; ++i) r[i] = points[i].norm();
+  std::vector<double> log_t(blocks), log_e(blocks), envelope(blocks);
+  for (std::size_t b = 0; b < blocks; ++b) {
+    const std::size_t from = b * n / blocks, to = (b + 1) * n / blocks;
+    std::size_t at = from;
+    for (std::size_t i = from; i < to; ++i) {
+      if (r[i] > r[at]) at = i;
+    }
+    envelope[b] = r[at];
+    const double t = first_point_time + static_cast<double>(at);
+    log_t[b] = std::log(t);
+    if (b == 0) g.first_time = t;
+    if (b + 1 == blocks) g.last_time = t;
+  }
+  g.first = envelope.front();
+  g.last = envelope.back();
+  // A motion at rest (a zero envelope somewhere) does not grow; its logarithms are not taken.
+  if (*std::min_element(envelope.begin(), envelope.end()) <= 0.0) return g;
+  for (std::size_t b = 0; b < blocks; ++b) log_e[b] = std::log(envelope[b]);
+  g.monotone = true;
+  for (std::size_t b = 1; b < blocks; ++b) g.monotone = g.monotone && envelope[b] > envelope[b - 1];
+  g.rise = log_e.back() - log_e.front();
+  g.exponent = slope(log_t, log_e, 0, blocks);
+  g.late_exponent = slope(log_t, log_e, blocks / 2, blocks);
+  g.growing = g.monotone && g.rise >= options.growth_rise &&
+              g.exponent >= options.growth_exponent && g.late_exponent >= options.growth_exponent;
+  return g;
+}
+
 void check_evidence(const MotionEvidence& evidence) {
   if (evidence.lyapunov && !std::isfinite(*evidence.lyapunov)) {
     throw InputError(fmt::format("MotionEvidence.lyapunov = {} is not finite", *evidence.lyapunov));
@@ -85,6 +154,10 @@ void check_evidence(const MotionEvidence& evidence) {
       !(std::isfinite(*evidence.zero_one_K) && std::abs(*evidence.zero_one_K) <= 1.0)) {
     throw InputError(fmt::format("MotionEvidence.zero_one_K = {} must be finite and in [-1, 1]",
                                  *evidence.zero_one_K));
+  }
+  if (!(evidence.first_point_time > 0.0) || !std::isfinite(evidence.first_point_time)) {
+    throw InputError(fmt::format("MotionEvidence.first_point_time = {} must be finite and > 0",
+                                 evidence.first_point_time));
   }
 }
 
@@ -123,6 +196,13 @@ bool ClassifierOptions::is_valid(std::string* why) const {
   if (!(divergence_bound > 0.0)) {
     return fail(why, fmt::format("ClassifierOptions.divergence_bound = {} must be > 0",
                                  divergence_bound));
+  }
+  if (growth_blocks < 4 || !(growth_exponent > 0.0) || !std::isfinite(growth_exponent) ||
+      !(growth_rise > 0.0) || !std::isfinite(growth_rise)) {
+    return fail(why, fmt::format("ClassifierOptions.growth_blocks = {}, growth_exponent = {}, "
+                                 "growth_rise = {}: need blocks >= 4 and a finite exponent and "
+                                 "rise > 0",
+                                 growth_blocks, growth_exponent, growth_rise));
   }
   if (observable_component < 0) {
     return fail(why, fmt::format("ClassifierOptions.observable_component = {} must be >= 0",
@@ -187,6 +267,22 @@ Classification classify_motion(const std::vector<Vector>& points, const MotionEv
     c.reason = fmt::format("uncertain: {} points are too few to test any period (need {})",
                            points.size(), options.period.cycles + 1);
     return c;
+  }
+
+  // Rule 4a: secular growth, unless λ1 says the map contracts (see the header).
+  if (lyapunov != Sign::negative) {
+    const Growth g = measure_growth(points, evidence.first_point_time, options);
+    if (g.ran) c.growth_exponent = g.exponent;
+    if (g.growing) {
+      c.regime = Regime::unbounded;
+      c.reason = fmt::format(
+          "unbounded: the amplitude grows like t^{:.2f} over the record (t^{:.2f} over its second "
+          "half): the envelope of |y| rises in each of {} blocks, from {:.4g} at t = {:g} to "
+          "{:.4g} at t = {:g} iterations; no period up to {} (best k = {}, mismatch {:.2g}); {}",
+          g.exponent, g.late_exponent, g.blocks, g.first, g.first_time, g.last, g.last_time,
+          options.period.k_max, c.period_search.best_k, c.period_search.mismatch, describe(c));
+      return c;
+    }
   }
 
   // Rule 4: bring in the 0-1 test.

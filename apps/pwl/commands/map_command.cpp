@@ -5,7 +5,9 @@
 
 #include <memory>
 
+#include "commands/cli_checks.hpp"
 #include "commands/commands.hpp"
+#include "commands/study_flag_checks.hpp"
 #include "commands/map_command.hpp"
 #include "output/gnuplot.hpp"
 #include "pwl/study/regime_map.hpp"
@@ -54,9 +56,12 @@ analysis::RegimeMapOptions map_options(const MapFlags& f) {
   }
   o.first.parameter = parse_model_parameter(model, "--x", f.x);
   parse_range("--x-range", f.x_range, &o.first.from, &o.first.to);
+  check_range_ends(model, o.first.parameter, "--x-range", f.x_range, o.first.from, o.first.to);
   o.first.points = f.x_points;
   o.second.parameter = parse_model_parameter(model, "--y", f.y);
   parse_range("--y-range", f.y_range, &o.second.from, &o.second.to);
+  check_range_ends(model, o.second.parameter, "--y-range", f.y_range, o.second.from,
+                   o.second.to);
   o.second.points = f.y_points;
   o.mode = f.mode == "continuation" ? analysis::SweepMode::continuation
                                     : analysis::SweepMode::independent;
@@ -83,16 +88,19 @@ void add_map_flags(CLI::App& c, MapFlags& flags) {
                "spring<j>.stiffness, spring<j>.gap, load<j>.amplitude, load<j>.frequency or\n"
                "damping of a --structure-scene");
   c.add_option("--x-range", flags.x_range, "FROM:TO of the horizontal parameter");
-  c.add_option("--x-points", flags.x_points, "Values of the horizontal parameter");
+  c.add_option("--x-points", flags.x_points, "Values of the horizontal parameter")
+      ->check(positive_number());
   c.add_option("--y", flags.y, "Vertical parameter");
   c.add_option("--y-range", flags.y_range, "FROM:TO of the vertical parameter");
-  c.add_option("--y-points", flags.y_points, "Values of the vertical parameter");
+  c.add_option("--y-points", flags.y_points, "Values of the vertical parameter")
+      ->check(positive_number());
   c.add_option("--mode", flags.mode,
                "independent (every cell from rest, or from --x0/--v0) or continuation (each row\n"
                "upward in the horizontal parameter from the previous cell's final state, its\n"
                "first cell from rest or --x0/--v0)")
       ->check(CLI::IsMember({"independent", "continuation"}));
   add_point_flags(c, flags.point, false);
+  check_point_flags(c);
   add_section_flags(c, flags.section,
                     "A map keeps no Poincaré points, so only strobe is\n"
                     "accepted: --phase sets the stroboscopic points each cell is classified on");

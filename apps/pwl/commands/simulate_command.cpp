@@ -207,7 +207,8 @@ void add_simulate_flags(CLI::App& c, SimulateOptions& options) {
                     "crossings, t the crossing time) and the phase portrait draws them");
   RecordingOptions& output = options.output;
   c.add_option("--record", output.record, "Masses (1-based) whose trajectory to write")
-      ->delimiter(',');
+      ->delimiter(',')
+      ->check(positive_number());
   c.add_option("--trajectory-periods", output.trajectory_periods,
                "Write the trajectory of only the last N periods (0: every kept period)")
       ->check(non_negative_number());

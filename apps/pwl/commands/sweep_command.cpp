@@ -11,7 +11,9 @@
 #include <memory>
 #include <set>
 
+#include "commands/cli_checks.hpp"
 #include "commands/commands.hpp"
+#include "commands/study_flag_checks.hpp"
 #include "commands/sweep_command.hpp"
 #include "output/gnuplot.hpp"
 #include "pwl/study/parameter_sweep.hpp"
@@ -107,6 +109,7 @@ analysis::SweepOptions sweep_options(const SweepFlags& f) {
   }
   o.parameter = parse_model_parameter(model, "--parameter", f.parameter);
   parse_range("--range", f.range, &o.from, &o.to);
+  check_range_ends(model, o.parameter, "--range", f.range, o.from, o.to);
   o.points = f.points;
   o.mode = f.mode == "continuation" ? analysis::SweepMode::continuation
                                     : analysis::SweepMode::independent;
@@ -167,7 +170,8 @@ void add_sweep_flags(CLI::App& c, SweepFlags& flags) {
                "chain; spring<j>.stiffness, spring<j>.gap, load<j>.amplitude, load<j>.frequency\n"
                "or damping (scales C) of a --structure-scene (j from 1)");
   c.add_option("--range", flags.range, "FROM:TO, from < to");
-  c.add_option("--points", flags.points, "Number of parameter values N");
+  // At least 1, checked with the sweep (SweepOptions::is_valid: "points = 0 must be at least 1").
+  c.add_option("--points", flags.points, "Number of parameter values N")->check(finite_number());
   c.add_option("--mode", flags.mode,
                "independent (every point from rest, or from --x0/--v0) or continuation (from the\n"
                "previous point's final state, upward and downward; each branch's first point\n"
@@ -176,6 +180,7 @@ void add_sweep_flags(CLI::App& c, SweepFlags& flags) {
   c.add_option("--directions", flags.directions, "Continuation branches: both, up or down")
       ->check(CLI::IsMember({"both", "up", "down"}));
   add_point_flags(c, flags.point, true);
+  check_point_flags(c);
   add_section_flags(c, flags.section,
                     "poincare.csv (t, the crossing time, instead\n"
                     "of period_index for a hyperplane) and the diagram get the section's points of\n"

@@ -24,6 +24,7 @@
 //  4. No period found. λ1 is read as positive (λ1 - error > margin), zero (|λ1| + error <=
 //     margin), negative (λ1 + error < -margin), inconclusive (otherwise) or unknown; K as chaotic
 //     (K > chaotic_K), regular (K < regular_K), in between, or unknown.
+//       - unbounded, by secular growth (rule 4a below), unless λ1 is negative;
 //       - positive and chaotic                  -> chaotic
 //       - zero and regular                      -> quasi-periodic
 //       - positive, K unknown                   -> chaotic        (unless require_all_indicators)
@@ -32,6 +33,41 @@
 //       - λ1 unknown, regular                   -> quasi-periodic (unless require_all_indicators)
 //       - anything else (disagreement, an inconclusive or in-between value, λ1 < 0 without a
 //         period: a period beyond k_max or a transient not yet over) -> uncertain.
+//
+// Rule 4a, secular growth. A motion can grow without bound and still stay far below
+// divergence_bound over the record: an undamped linear resonance, x'' + x = sin t from rest,
+// x = (sin t - t cos t) / 2, grows like t and its stroboscopic points march off along a line,
+// which the period search does not repeat, λ1 reads as zero (its tangent map is a rotation) and
+// the 0-1 test as regular, so that rules 2-4 would call it quasi-periodic. Rule 4a measures the growth itself, on the amplitude r_i = |p_i|
+// (the Euclidean norm of point i) against the time since the initial state, t_i =
+// evidence.first_point_time + i map iterations:
+//
+//   - the record is cut into growth_blocks equal blocks (at least 4 points each; fewer points
+//     than 4 growth_blocks: no test) and the envelope E_b = max r_i over block b is taken at the
+//     time t_b of that maximum. The envelope, not r_i itself, because an oscillation that grows
+//     (beating of several modes on top of the growth, a norm that dips at some phase) has a
+//     rising envelope while r_i itself goes up and down;
+//   - significance: the envelope must rise in every block, E_0 < E_1 < ... (the maxima of a
+//     bounded stationary motion over equal blocks are exchangeable, so they rise in all of 8
+//     blocks by chance with probability 1/8! = 2.5e-5; a periodic record has equal maxima), and by
+//     at least growth_rise in log over the record (log(E_last / E_0) >= 0.1, a rise of 10.5%), so
+//     that a growth is never read from a few rounding-level changes;
+//   - linear or faster: the least-squares slope p of log E_b on log t_b (the power of t the
+//     amplitude grows like: 1 for a resonance from rest) is at least growth_exponent = 0.75, over
+//     the whole record and over its second half alike. The second half is what tells a growth
+//     from a transient still settling onto a bounded motion: an approach A (1 - exp(-t/τ)) has
+//     the local exponent (t/τ) / (exp(t/τ) - 1), which falls below 0.75 once t > 0.55 τ, while a
+//     power law keeps its exponent. 0.75 rather than 1 leaves room for a start away from rest:
+//     r = sqrt(r0^2 + (c t)^2) grows with the exponent (c t)^2 / r^2 >= 0.75 once c t >= 1.7 r0.
+//     A slower, sub-linear rise is not called unbounded: within one record it cannot be told
+//     from such an approach;
+//   - a negative λ1 rules growth out: a map that contracts every nearby pair of states keeps a
+//     forced response bounded, so a rising envelope there is a transient settling, however slow.
+//
+// The test can only see what the record holds. A beat more than about twice as long as the
+// record may rise over all of it like a growth; and a growth like t rises by the factor
+// (t_first + N) / t_first over N recorded iterations, which passes growth_rise only when the
+// record is at least a tenth of the time before it. More recorded periods settle both.
 //
 // Where K comes from: evidence.zero_one_K if given; else the 0-1 test on evidence.observable if
 // that is not empty; else, if zero_one_from_points, the 0-1 test on coordinate
@@ -68,6 +104,10 @@ struct MotionEvidence {
   double lyapunov_error = 0.0;           // its uncertainty (>= 0), e.g. LyapunovResult::error
   std::optional<double> zero_one_K;      // K from an earlier 0-1 test, in [-1, 1]
   std::vector<double> observable;        // a scalar series for the 0-1 test, if K is not given
+  // The time of points[0] since the initial state, in iterations of the map (forcing periods of
+  // a stroboscopic map); the points are one iteration apart. Rule 4a measures growth against it:
+  // for points recorded after a transient of m iterations it is m + 1 (> 0).
+  double first_point_time = 1.0;
 };
 
 struct ClassifierOptions {
@@ -84,6 +124,12 @@ struct ClassifierOptions {
   Index observable_component = 0;
   // Demand both λ1 and K before calling a motion chaotic or quasi-periodic.
   bool require_all_indicators = false;
+  // Rule 4a, secular growth (see above): whether it runs, its blocks (>= 4), the smallest power
+  // of t called growth (> 0) and the smallest rise of the envelope, in log, over the record (> 0).
+  bool detect_growth = true;
+  int growth_blocks = 8;
+  double growth_exponent = 0.75;
+  double growth_rise = 0.1;
 
   bool is_valid(std::string* why) const;
 };
@@ -97,13 +143,17 @@ struct Classification {
   std::optional<double> zero_one_K;     // given or computed; empty when not available or not needed
   std::string zero_one_source;          // "given", "observable", "points", or empty
   std::string reason;                   // the rule that decided, with the numbers
+  // Rule 4a's fitted power of t of the amplitude's envelope over the whole record, when it ran
+  // (no period found, enough points, λ1 not negative).
+  std::optional<double> growth_exponent;
 
   std::string name() const { return regime_name(regime, period); }
 };
 
 // Throws InputError for invalid options, no points, points of differing dimensions, a non-finite
-// λ1 or K, a negative lyapunov_error, K outside [-1, 1], or an observable_component out of range
-// when K is to be computed from the points. Non-finite points are not an error: they are rule 1.
+// λ1 or K, a negative lyapunov_error, K outside [-1, 1], a first_point_time that is not positive
+// and finite, or an observable_component out of range when K is to be computed from the points.
+// Non-finite points are not an error: they are rule 1.
 Classification classify_motion(const std::vector<Vector>& points,
                                const MotionEvidence& evidence = {},
                                const ClassifierOptions& options = {});
