@@ -337,3 +337,25 @@ TEST_CASE("the method's capabilities decide how λ1 is estimated", "[sweep_point
   CHECK(parse_lyapunov_estimate("two-trajectories") == LyapunovEstimate::two_trajectories);
   CHECK_THROWS_AS(parse_lyapunov_estimate("qr"), InputError);
 }
+
+TEST_CASE("a point whose exact integration spends its work budget fails alone", "[sweep_point]") {
+  // Figure 4a's chain switches 5 to 7 times per forcing period (event_driven_solver.hpp); with a
+  // budget of 2 switches per call the exact solver stops in the first period with BudgetError,
+  // which a study records as a failed point (not an end of the study). With the default budget
+  // the same point is classified.
+  PointSettings s;
+  s.transient_periods = 20;
+  s.recorded_periods = 100;
+  s.method.method = Method::exact;
+  s.lyapunov_estimate = LyapunovEstimate::two_trajectories;
+  const PointCase point(paper_five_dof_case("4a"));
+  PointSettings starved = s;
+  starved.method.event_driven.max_events = 2;
+  const PointResult failed = evaluate_point(point, Vector::Zero(10), starved);
+  CHECK(failed.regime == "failed");
+  CHECK(failed.final_state.size() == 0);
+  CHECK(failed.rows() == 0);
+  const PointResult classified = evaluate_point(point, Vector::Zero(10), s);
+  CHECK(classified.regime == "period-2");
+  CHECK(classified.final_state.size() == 10);
+}

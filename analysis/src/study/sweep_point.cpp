@@ -174,6 +174,7 @@ void two_trajectory_lyapunov(const PointCase& point, const MethodSettings& metho
     result.lambda1_error = lyapunov.error[0];
   } catch (const DivergenceError&) {
   } catch (const LcpError&) {
+  } catch (const BudgetError&) {
   }
 }
 
@@ -275,9 +276,19 @@ PointResult evaluate_point(const PointCase& point, const Vector& initial_state,
     result.regime = "failed";
     result.final_state.resize(0);
     return result;
+  } catch (const BudgetError&) {
+    // The exact solver spent its work budget on one period (contacts too stiff for it): this
+    // point failed, the study goes on.
+    result.regime = "failed";
+    result.final_state.resize(0);
+    return result;
   }
 
   MotionEvidence evidence;
+  // The first classified point is the strobe of period transient + 1, at (transient + 1 + phase) T
+  // from the initial state: the time the growth test (rule 4a of the classifier) measures the
+  // amplitude's power of t against.
+  evidence.first_point_time = sampler.strobe_time(s.transient_periods + 1) / period;
   if (tangent) {
     LyapunovOptions l;
     const Averaging a = averaging(static_cast<long>(jacobians.size()), s.recorded_periods);

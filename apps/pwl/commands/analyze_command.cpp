@@ -19,6 +19,7 @@
 
 #include "commands/cli_checks.hpp"
 #include "commands/commands.hpp"
+#include "commands/step_guard_report.hpp"
 #include "output/csv_writer.hpp"
 #include "output/gnuplot.hpp"
 #include "pwl/errors.hpp"
@@ -125,6 +126,7 @@ AnalyzeResult analyze_case(const AnalyzeOptions& o, analysis::PointObserver* als
   s.transient_periods = o.transient;
   s.recorded_periods = recorded;
   s.method = o.run.method_settings(period);
+  guard_step(structure, s.method, period, o.run.force);
   const MethodTraits& method = method_traits(s.method.method);
   if (method.fixed_grid) s.steps_per_period = static_cast<int>(std::lround(period / s.method.step));
   s.observable = mass - 1;  // the 0-1 test reads x of the drawn mass
@@ -236,13 +238,16 @@ void analyze(const AnalyzeOptions& o) {
 
 void add_analyze_flags(CLI::App& c, AnalyzeOptions& options) {
   add_case_options(c, options.run);
+  // The analysis leaves out --transient periods, not --skip-periods: one flag for one thing.
+  c.remove_option(c.get_option("--skip-periods"));
   add_section_flags(c, options.section,
                     "poincare.csv and the figure's Poincaré panel get the section's\n"
                     "points of the recorded periods");
   c.add_option("--transient", options.transient, "Periods discarded before the analysis")
       ->check(non_negative_number());
   c.add_option("--mass", options.mass,
-               "Mass (1-based) drawn in the figure and read by the 0-1 test (default: last)");
+               "Mass (1-based) drawn in the figure and read by the 0-1 test (0: the last)")
+      ->check(non_negative_number());
   c.add_option("--lyapunov", options.lyapunov,
                "How λ1 is estimated: tangent-vector, tangent-frame or two-trajectories\n"
                "(default, as pwl sweep and map: tangent-vector when the method has an exact\n"

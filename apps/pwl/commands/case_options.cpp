@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "commands/cli_checks.hpp"
+#include "commands/step_guard_report.hpp"
 #include "pwl/errors.hpp"
 #include "pwl/integrators/method_table.hpp"
 #include "scene/scene_structure.hpp"
@@ -18,18 +19,29 @@ void add_chain_options(CLI::App& c, std::string& figure, int& masses, std::vecto
   c.add_option("--figure", figure, "Start from one of the paper's 5-DOF cases: 4a, 4b, 5, 6")
       ->check(CLI::IsMember({"4a", "4b", "5", "6"}));
   c.add_option("--n", masses, "Number of masses")->check(positive_number());
-  // Unset chain parameters come from --figure's case, else from the chain's defaults.
+  // Unset chain parameters come from --figure's case, else from the chain's defaults. A NaN
+  // stands for "not given" in zeta, gap and theta, so their validators refuse a typed NaN (and
+  // ±Inf) before it can pass for the default. θ's sign is the chain's own check (make_chain:
+  // "theta = -1 must be positive and finite"), which every job runs before any work, through
+  // CaseOptions::structure or CaseOptions::model.
   const NondimensionalChain d;
   const auto preset = [](double value) { return fmt::format("{} or --figure's", value); };
   c.add_option("--alpha", alpha, "Contact stiffness ratio k2/k1 (one value or one per mass)")
       ->delimiter(',')
+      ->check(non_negative_number())
       ->default_str(preset(d.alpha[0]));
-  c.add_option("--zeta", zeta, "Damping ratio c/sqrt(k1 m)")->default_str(preset(d.zeta));
-  c.add_option("--gap", gap, "Nondimensional gap of every mass's spring")
+  c.add_option("--zeta", zeta, "Damping ratio c/sqrt(k1 m)")
+      ->check(non_negative_number())
+      ->default_str(preset(d.zeta));
+  c.add_option("--gap", gap, "Nondimensional gap of every mass's spring (negative: preloaded)")
+      ->check(finite_number())
       ->default_str(preset(d.gap[0]));
-  c.add_option("--theta", theta, "Forcing frequency ratio ω/ω0")->default_str(preset(d.theta));
+  c.add_option("--theta", theta, "Forcing frequency ratio ω/ω0")
+      ->check(finite_number())
+      ->default_str(preset(d.theta));
   c.add_option("--loads", loads, "Load amplitudes Q per mass, comma separated")
       ->delimiter(',')
+      ->check(finite_number())
       ->default_str(fmt::format("{} or --figure's", fmt::join(d.amplitude, ",")));
 }
 
@@ -45,17 +57,18 @@ Vector InitialStateFlags::state(Index dofs) const {
   Vector y = Vector::Zero(2 * dofs);
   const auto fill = [&](const char* flag, const std::vector<double>& values, Index offset) {
     if (values.empty()) return;
-    const std::size_t n = static_cast<std::size_t>(dofs);
-    if (values.size() != 1 && values.size() != n) {
-      throw InputError(fmt::format("{} {}: {} values for {} masses; give one per mass or one value "
-                                   "for every mass",
-                                   flag, fmt::join(values, ","), values.size(), dofs));
-    }
+    // Each value first, then their count: a NaN is wrong whatever the number of masses.
     for (double value : values) {
       if (!std::isfinite(value)) {
         throw InputError(fmt::format("{} {}: {} is not a finite number", flag,
                                      fmt::join(values, ","), value));
       }
+    }
+    const std::size_t n = static_cast<std::size_t>(dofs);
+    if (values.size() != 1 && values.size() != n) {
+      throw InputError(fmt::format("{} {}: {} values for {} masses; give one per mass or one value "
+                                   "for every mass",
+                                   flag, fmt::join(values, ","), values.size(), dofs));
     }
     for (Index i = 0; i < dofs; ++i) {
       y[offset + i] = values.size() == 1 ? values[0] : values[static_cast<std::size_t>(i)];
@@ -117,15 +130,18 @@ void add_case_options(CLI::App& c, CaseOptions& o) {
   add_chain_options(c, o.figure, o.masses, o.alpha, o.zeta, o.gap, o.theta, o.loads);
   c.add_option("--gaps", o.gaps, "Gaps per mass, comma separated (overrides --gap)")
       ->delimiter(',')
+      ->check(finite_number())
       ->default_str("");
   c.add_option("--periods", o.periods, "Forcing periods to integrate")->check(positive_number());
   c.add_option("--skip-periods", o.skip_periods, "Leading periods left out of the output")
       ->check(non_negative_number());
   c.add_option("--steps-per-period", o.steps_per_period, "PIM steps per forcing period")
       ->check(positive_number());
-  c.add_option("--dt", o.dt, "PIM step (must divide the forcing period)");
+  c.add_option("--dt", o.dt, "PIM step (must divide the forcing period; 0: --steps-per-period)")
+      ->check(non_negative_number());
   c.add_option("--method", o.method, method_help())->check(CLI::IsMember(method_names()));
-  c.add_option("--tol", o.tolerance, "Relative and absolute tolerance of dopri5/rkf78");
+  c.add_option("--tol", o.tolerance, "Relative and absolute tolerance of dopri5/rkf78")
+      ->check(positive_number());
   c.add_flag("--locate-kinks", o.locate_kinks,
              "dopri5/rkf78: end a step exactly at every spring opening or closing");
   c.add_option("--structure-scene", o.structure_scene,
@@ -135,6 +151,7 @@ void add_case_options(CLI::App& c, CaseOptions& o) {
   c.add_option("--lcp", o.lcp_solver, "PIM's LCP solver: block-pivoting or lemke")
       ->check(CLI::IsMember({"block-pivoting", "lemke"}));
   add_initial_state_flags(c, o.start);
+  add_force_flag(c, o.force);
 }
 
 GapStructure CaseOptions::structure() const {
@@ -197,7 +214,14 @@ double CaseOptions::step(double period) const {
 }
 
 analysis::PointModel CaseOptions::model() const {
-  if (!explicit_structure()) return analysis::PointModel(chain());
+  if (!explicit_structure()) {
+    // The chain's own checks (θ > 0, ζ >= 0, α >= 0, one value or one per mass) on the flags as
+    // given, also when a study varies one of them: a sweep of θ from --theta -1 is refused like
+    // a simulation at θ = -1.
+    const NondimensionalChain c = chain();
+    make_chain(c);
+    return analysis::PointModel(c);
+  }
   return analysis::PointModel(analysis::ExplicitStructure{
       structure(), description(), std::filesystem::path(structure_scene).filename().string()});
 }
@@ -210,12 +234,15 @@ MethodSettings CaseOptions::method_settings(double period) const {
   m.locate_kinks = locate_kinks;
   m.max_step = period / 8;
   m.lcp = parse_lcp_algorithm(lcp_solver);
+  report_exact_progress(m);
   return m;
 }
 
 std::unique_ptr<Integrator> CaseOptions::integrator(const GapStructure& structure,
                                                     double period) const {
-  std::unique_ptr<Integrator> integrator = make_integrator(structure, method_settings(period));
+  const MethodSettings settings = method_settings(period);
+  guard_step(structure, settings, period, force);
+  std::unique_ptr<Integrator> integrator = make_integrator(structure, settings);
   if (!start.at_rest()) {
     const Index n = structure.dofs();
     const Vector y = start.state(n);

@@ -74,6 +74,7 @@ struct CaseOptions {
   // the chain; the chain's flags do not apply then.
   std::string structure_scene;
   InitialStateFlags start;  // --x0, --v0
+  bool force = false;       // --force: run a step the step guard refuses
 
   // The chain these flags describe (the preset, then each given flag).
   NondimensionalChain chain() const;
@@ -90,14 +91,16 @@ struct CaseOptions {
   std::string description() const;
   // The step the PIM uses: period / steps_per_period, or dt when it divides the period.
   double step(double period) const;
-  // The method table's settings these flags give (the step only for fixed-grid methods).
+  // The method table's settings these flags give (the step only for fixed-grid methods; for the
+  // exact solver, its progress on stderr during a long advance: step_guard_report.hpp).
   MethodSettings method_settings(double period) const;
   // The integrator the flags name, with its state at t = 0 that of --x0 and --v0 (rest when they
-  // are not given). Throws InputError naming --x0 or --v0 for a wrong value.
+  // are not given), its step judged by the step guard first (step_guard_report.hpp). Throws
+  // InputError naming --x0 or --v0 for a wrong value, or the guard's refusal without --force.
   std::unique_ptr<Integrator> integrator(const GapStructure& structure, double period) const;
 };
 
-// The case flags, --x0 and --v0 among them.
+// The case flags, --x0, --v0 and --force among them.
 void add_case_options(CLI::App& command, CaseOptions& options);
 
 // --method's help: one line per row of the method table.

@@ -21,6 +21,7 @@
 #include "commands/commands.hpp"
 #include "commands/continue_command.hpp"
 #include "commands/orbit_options.hpp"
+#include "commands/step_guard_report.hpp"
 #include "commands/study_runner.hpp"
 #include "commands/sweep_command.hpp"
 #include "output/gnuplot.hpp"
@@ -498,6 +499,15 @@ ContinuationProblem continuation_problem(const ContinueFlags& f) {
   const OrbitMethod method = orbit_method(o, first_case.structure, first_case.period);
   if (!method_traits(method.settings.method).fixed_grid && o.run.dt != 0.0) {
     throw InputError("--dt: the continuation's step is --steps-per-period (the period varies)");
+  }
+  {
+    // orbit_method judged the step at the start; η ω_max grows or shrinks monotonically with
+    // every parameter a model varies (stiffness, damping, frequency), so the far end is the
+    // other extreme the branch can reach.
+    const analysis::PointCase last_case = base.with(parameter, to).point_case();
+    guard_step(last_case.structure,
+               method.settings.for_period(last_case.period, method.steps_per_period),
+               last_case.period, o.run.force);
   }
   orbits::ContinuationOptions c;
   c.parameter = parameter;

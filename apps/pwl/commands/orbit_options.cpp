@@ -9,6 +9,7 @@
 #include <map>
 
 #include "commands/cli_checks.hpp"
+#include "commands/step_guard_report.hpp"
 #include "pwl/errors.hpp"
 #include "pwl/integrators/method_table.hpp"
 
@@ -77,6 +78,7 @@ OrbitMethod orbit_method(const OrbitFlags& f, const GapStructure& structure, dou
                      : "pim-switching";
   }
   m.settings = run.method_settings(period);  // checks --dt against the period
+  guard_step(structure, m.settings, period, f.run.force);
   m.steps_per_period = method_traits(m.settings.method).fixed_grid
                            ? static_cast<int>(std::lround(period / m.settings.step))
                            : run.steps_per_period;

@@ -16,6 +16,7 @@
 #include "commands/analyze_command.hpp"
 #include "commands/map_command.hpp"
 #include "commands/simulate_command.hpp"
+#include "commands/step_guard_report.hpp"
 #include "commands/study_runner.hpp"
 #include "commands/sweep_command.hpp"
 #include "pwl/integrators/method_table.hpp"
@@ -240,8 +241,10 @@ void add_indicator_columns(py::dict& table, const std::map<long, analysis::Point
 }
 
 // Runs the study's points in this process (analysis::run_grid, as compute_study does), looking at
-// Ctrl-C after each finished point.
-std::map<long, analysis::PointResult> run_points(const app::Study& study, int threads) {
+// Ctrl-C after each finished point; the step guard first, as pwl sweep and pwl map do.
+std::map<long, analysis::PointResult> run_points(const app::Study& study, int threads,
+                                                 bool force) {
+  app::guard_study_steps(study.tasks, study.case_of, study.settings, force);
   std::map<long, analysis::PointResult> records;
   without_gil([&] {
     Interrupt interrupt;
@@ -266,7 +269,7 @@ py::dict sweep(py::kwargs kwargs) {
 
   const analysis::SweepOptions o = app::sweep_options(flags);
   const std::map<long, analysis::PointResult> records =
-      run_points(app::study_of(o), flags.run.threads);
+      run_points(app::study_of(o), flags.run.threads, flags.run.force);
   const int dofs = o.model().dofs();
   const bool crossings = !o.point.section.stroboscopic();
   const auto columns = static_cast<py::ssize_t>(o.point.components.size());
@@ -344,7 +347,7 @@ py::dict map(py::kwargs kwargs) {
 
   const analysis::RegimeMapOptions o = app::map_options(flags);
   const std::map<long, analysis::PointResult> records =
-      run_points(app::study_of(o), flags.run.threads);
+      run_points(app::study_of(o), flags.run.threads, flags.run.force);
   // map.csv's rows, by j then i (the id order).
   std::vector<int> i_column, j_column;
   std::vector<double> x_column, y_column;

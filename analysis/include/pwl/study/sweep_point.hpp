@@ -92,7 +92,7 @@ struct PointSettings {
 struct PointResult {
   // The indicators (indicators.hpp registers each one: its column, its journal token).
   std::string regime;  // regime_name(...) of the classifier, "unbounded", or "failed" (an
-                       // unsolvable LCP)
+                       // unsolvable LCP, or the exact solver's work budget spent: BudgetError)
   int period = 0;      // k for period-k, 0 otherwise
   double lambda1 = std::numeric_limits<double>::quiet_NaN();  // per forcing period; NaN: none
   double lambda1_error = std::numeric_limits<double>::quiet_NaN();
@@ -129,7 +129,8 @@ class PointObserver {
   // Every recorded point of the section, the full state [x; v] at time t in period k: for a
   // stroboscopic section t = (k + phase) T, for a hyperplane the crossing's time.
   virtual void poincare_point(int /*k*/, double /*t*/, const Vector& /*state*/) {}
-  // Once, when the recorded points are classified (not for an unbounded or failed motion).
+  // Once, when the recorded points are classified (not for a motion that blew up or failed; a
+  // growth found by the classifier is classified, and "unbounded").
   virtual void classified(const Classification& /*classification*/,
                           const PointResult& /*result*/) {}
 };
@@ -139,7 +140,11 @@ class PointObserver {
 // and classifies their stroboscopic points: the period search on the full state, λ1 over the recorded periods as settings.lyapunov_estimate says (the
 // first min(50, recorded/5) periods align the tangent vector or frame, the rest are averaged in
 // min(10, ...) blocks), and K on the observable when at least 100 points are recorded. A motion
-// that blows up is "unbounded" (not an exception). Throws InputError for invalid settings or state.
+// that blows up is "unbounded" (not an exception), and so is one that grows without bound while
+// staying finite over the record, such as an undamped resonance: the classifier's secular-growth
+// rule (motion_classifier.hpp, rule 4a) measures the amplitude's power of t against the time since
+// the initial state; its final state is then left empty, as for a blow-up. Throws InputError for
+// invalid settings or state.
 PointResult evaluate_point(const PointCase& point, const Vector& initial_state,
                            const PointSettings& settings, PointObserver* observer = nullptr);
 
