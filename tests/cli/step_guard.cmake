@@ -49,3 +49,16 @@ add_test(NAME cli_simulate_exact_stiff_contact
          COMMAND sh -c "\"$<TARGET_FILE:pwl>\" simulate --n 5 --alpha 1e9 --method exact --periods 20 --quiet --out ${PWL_CLI_OUT}/exact_stiff && test $(wc -l < ${PWL_CLI_OUT}/exact_stiff/poincare.csv) -eq 22 && awk -F, 'NR > 1 { for (i = 2; i <= 6; ++i) if ($i > 3 || $i < -3) bad = 1 } END { exit bad }' ${PWL_CLI_OUT}/exact_stiff/poincare.csv && \"$<TARGET_FILE:pwl>\" simulate --n 5 --alpha 1e9 --method exact --periods 5 --quiet --out ${PWL_CLI_OUT}/exact_stiff5 && \"$<TARGET_FILE:pwl>\" simulate --n 5 --alpha 1e9 --method rkf78 --tol 1e-13 --locate-kinks --periods 5 --quiet --out ${PWL_CLI_OUT}/exact_stiff_rkf78 && ${PWL_COMPARE_POINCARE} ${PWL_CLI_OUT}/exact_stiff5/poincare.csv ${PWL_CLI_OUT}/exact_stiff_rkf78/poincare.csv 6 3e-8")
 # Row 4, the undamped resonance called unbounded, is cli_analyze_undamped_resonance_unbounded
 # (bad_values.cmake).
+# The adaptive rows have no step to judge; their tolerance is. Looser than 1e-5 (where pwl bench
+# stability finds them missing contacts or settling on the wrong regime) draws a warning, in a
+# single case and once for a whole sweep; 1e-5 and tighter nothing.
+add_test(NAME cli_simulate_loose_tolerance_warning
+         COMMAND sh -c "\"$<TARGET_FILE:pwl>\" simulate --figure 4a --method dopri5 --tol 1e-3 --periods 2 --quiet --out ${PWL_CLI_OUT}/loose_tolerance 2>&1 && \"$<TARGET_FILE:pwl>\" simulate --figure 4a --method dopri5 --tol 1e-5 --periods 2 --quiet --out ${PWL_CLI_OUT}/tight_tolerance 2>&1")
+set_tests_properties(cli_simulate_loose_tolerance_warning PROPERTIES
+                     PASS_REGULAR_EXPRESSION "^pwl: warning: dopri5: tolerance 0.001 is loose for gap springs.*use a tolerance of at most 1e-05\n$")
+add_test(NAME cli_sweep_loose_tolerance_warning
+         COMMAND pwl sweep --figure 4a --parameter theta --range 1:1.2 --points 3 --transient 2
+                 --periods 2 --method rkf78 --locate-kinks --tol 1e-4 --no-lyapunov --no-plot
+                 --quiet --out ${PWL_CLI_OUT}/loose_tolerance_sweep)
+set_tests_properties(cli_sweep_loose_tolerance_warning PROPERTIES PASS_REGULAR_EXPRESSION
+                     "pwl: warning: 3 of the 3 points of this study draw a warning from the step guard \\(the same for every point\\); the first, point 0: rkf78: tolerance 0.0001 is loose")

@@ -331,3 +331,43 @@ TEST_CASE("the step guard accepts the paper's settings and every shipped scene's
                    fixed_step(Method::pim, paper_five_dof_case("4a").period() / 200))
             .step_argument == Approx(0.0745).margin(5e-4));
 }
+
+TEST_CASE("a tolerance looser than 1e-5 draws a warning where the Runge-Kutta rows go wrong",
+          "[step_guard]") {
+  // Figure 4a's chain with α = 3, whose motion is period-2: plain dopri5 at 1e-4 settles on
+  // another motion (pwl bench stability: the wrong regime), at 1e-6 it follows the exact solver.
+  const NondimensionalChain c = chain_case("4a", 3.0);
+  const GapStructure s = make_chain(c);
+  const double T = c.period();
+  const auto adaptive = [&](Method method, double tolerance, bool kinks) {
+    MethodSettings m;
+    m.method = method;
+    m.tolerance = tolerance;
+    m.locate_kinks = kinks;
+    m.max_step = T / 8;
+    return m;
+  };
+  for (const Method method : {Method::dopri5, Method::rkf78}) {
+    for (const bool kinks : {false, true}) {
+      for (const double loose : {1e-3, 1e-4, 2e-5}) {
+        const StepCheck check = check_step(s, adaptive(method, loose, kinks), T);
+        INFO(check.message);
+        CHECK(check.verdict == StepVerdict::warning);
+        CHECK_FALSE(check.refused());
+        CHECK(check.message.find(fmt::format("tolerance {}", loose)) != std::string::npos);
+        CHECK(check.message.find("at most 1e-05") != std::string::npos);
+      }
+      for (const double tight : {1e-5, 1e-6, 1e-10}) {
+        CHECK(check_step(s, adaptive(method, tight, kinks), T).ok());
+      }
+    }
+  }
+  // The warning is where the answers go wrong: over 200 periods plain dopri5 at 1e-4 strays
+  // 3e-2 from the exact motion (measured 0.030), at 1e-6 forty times less (8.1e-4).
+  const double warned = error_against_exact(s, T, 200, adaptive(Method::dopri5, 1e-4, false));
+  const double accepted = error_against_exact(s, T, 200, adaptive(Method::dopri5, 1e-6, false));
+  INFO("dopri5 error against the exact solver: " << warned << " at 1e-4, " << accepted
+                                                 << " at 1e-6");
+  CHECK(warned > 1e-2);
+  CHECK(accepted < 2e-3);
+}

@@ -31,7 +31,6 @@ void guard_step(const GapStructure& structure, const MethodSettings& settings, d
 void guard_study_steps(const std::vector<analysis::GridTask>& tasks,
                        const analysis::PointCaseOf& case_of,
                        const analysis::PointSettings& settings, bool force, bool print) {
-  if (!(method_traits(settings.method.method).step_limit > 0.0)) return;
   long points = 0, warned = 0, refused = 0;
   long first_id = -1, first_refused_id = -1;
   std::string first_message, first_refused_message;
@@ -59,8 +58,10 @@ void guard_study_steps(const std::vector<analysis::GridTask>& tasks,
     }
   }
   if (warned == 0) return;
-  const std::string every = fmt::format(
-      "--steps-per-period {} or more satisfies every point", steps_per_period);
+  const std::string every =
+      steps_per_period > 0
+          ? fmt::format("--steps-per-period {} or more satisfies every point", steps_per_period)
+          : std::string("the same for every point");
   if (refused > 0 && !force) {
     throw InputError(fmt::format(
         "the step guard refuses {} of the {} points of this study ({}); the first, point {}: "
@@ -75,8 +76,8 @@ void guard_study_steps(const std::vector<analysis::GridTask>& tasks,
                refused, points, every, first_refused_id, first_refused_message);
   } else {
     fmt::print(stderr,
-               "pwl: warning: {} of the {} points of this study resolve the stiffest contact "
-               "poorly ({}); the first, point {}: {}\n",
+               "pwl: warning: {} of the {} points of this study draw a warning from the step "
+               "guard ({}); the first, point {}: {}\n",
                warned, points, every, first_id, first_message);
   }
 }

@@ -8,7 +8,8 @@
 // and the steps per period that would do. --force runs the step anyway for those who know what
 // they are asking for (a stability study of the method itself, say); the refusal is then printed
 // on standard error as a warning. A warning (a step that resolves the contact poorly but does not
-// miss it) is printed on standard error and the job goes on.
+// miss it, or an adaptive method's tolerance looser than 1e-5) is printed on standard error and
+// the job goes on.
 //
 // A study (sweep, map) is judged on every point before its first point is computed, so that a
 // refusal costs nothing; the message counts the points and names the first, with the steps per

@@ -76,6 +76,13 @@ double gershgorin_bound(const SparseMatrix& a, const SparseMatrix& mass) {
 
 std::string fixed(double v) { return fmt::format("{:.3g}", v); }
 
+// Adaptive rows: a tolerance looser than this draws a warning. Measured by `pwl bench stability
+// --alpha 3,10,30,100,1000 --tol 1e-3,1e-4,1e-5,1e-6` on figure 4a's chain over 200 periods:
+// at 1e-3 every Runge-Kutta row fails somewhere (missed contacts, kink-located, for α >= 30; the
+// wrong period, plain, for α <= 10), at 1e-4 plain dopri5 gets the period wrong for α <= 10 and
+// the kink-located rows miss contacts at α = 1000; at 1e-5 and 1e-6 none fails.
+constexpr double kLooseTolerance = 1e-5;
+
 }  // namespace
 
 ContactFrequency contact_frequency(const GapStructure& structure) {
@@ -110,6 +117,16 @@ StepCheck check_step(const GapStructure& structure, const MethodSettings& settin
   StepCheck c;
   c.omega_max = contact_frequency(structure).omega_max;
   c.largest_step = c.largest_accepted_step = kInfinity;
+  if (row.adaptive && settings.tolerance > kLooseTolerance) {
+    c.verdict = StepVerdict::warning;
+    c.message = fmt::format(
+        "{}: tolerance {} is loose for gap springs: pwl bench stability finds dopri5 and rkf78 "
+        "at tolerances 1e-3 and 1e-4 missing contacts or settling on the wrong regime (the paper's "
+        "chain, α from 3 to 1000, kink-located or not), and none at 1e-5 or tighter; use a "
+        "tolerance of at most {:g}",
+        row.name, settings.tolerance, kLooseTolerance);
+    return c;
+  }
   if (!(row.step_limit > 0.0)) return c;  // no step to guard (step_guard.hpp)
 
   c.step = settings.step;
