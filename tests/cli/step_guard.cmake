@@ -39,7 +39,7 @@ foreach(job "analyze --n 5 --alpha 1e9 --steps-per-period 20|pim: step = 0.314 i
   string(REGEX REPLACE "[^A-Za-z0-9_]" "" name "${name}")
   string(SUBSTRING "${name}" 0 60 name)
   add_test(NAME cli_step_guard_${name}
-           COMMAND sh -c "rm -rf ${PWL_CLI_OUT}/guard_${command}; out=$(\"$<TARGET_FILE:pwl>\" ${flags} --out ${PWL_CLI_OUT}/guard_${command} 2>&1); code=$?; echo \"$out\"; test $code -eq 2 && echo \"$out\" | grep -qF -- '${message}' && test ! -e ${PWL_CLI_OUT}/guard_${command}")
+           COMMAND sh -c "rm -rf ${PWL_CLI_OUT}/guard_${name}; out=$(\"$<TARGET_FILE:pwl>\" ${flags} --out ${PWL_CLI_OUT}/guard_${name} 2>&1); code=$?; echo \"$out\"; test $code -eq 2 && echo \"$out\" | grep -qF -- '${message}' && test ! -e ${PWL_CLI_OUT}/guard_${name}")
 endforeach()
 # Row 3: the exact solver on the same α = 1e9 contact finishes 20 periods (it took more than ten
 # minutes before its stiff contacts were settled in closed form), stays bounded, and agrees with
