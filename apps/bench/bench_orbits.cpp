@@ -117,6 +117,7 @@ struct ShootingRow {
   std::string failure;   // Newton's message when it did not converge
   int iterations = 0;
   long evaluations = 0;
+  long replays = 0;  // tangent products replayed from a recorded integration
   long krylov_products = 0;
   bool preconditioned = false;
   double residual = 0.0;
@@ -267,6 +268,7 @@ void run_shooting(ShootingGroup& g, const OrbitBenchOptions& o,
         row.converged = true;
         row.iterations = orbit.iterations;
         row.evaluations = orbit.evaluations;
+        row.replays = orbit.tangent_replays;
         row.krylov_products = orbit.krylov_products;
         row.preconditioned = orbit.preconditioned;
         row.residual = orbit.residual;
@@ -503,7 +505,9 @@ std::string format_tables(const OrbitBenchOptions& o, const std::vector<Shooting
             "| {} | {} | {} | {} | {:.3g} | {} | {} | {} | {} | {:.1e} | {} | {} | {} | {} | {} | "
             "{} |\n",
             r.case_label, r.masses, method_text(r), solver, r.setup, seconds_text(r.seconds, r.cpu),
-            r.iterations, r.evaluations,
+            r.iterations,
+            r.replays > 0 ? fmt::format("{} (+{} replayed)", r.evaluations, r.replays)
+                          : fmt::format("{}", r.evaluations),
             r.solver == ShootingSolver::krylov ? fmt::format("{}", r.krylov_products) : "-",
             r.residual,
             r.multipliers_converged ? fmt::format("{:.6g}", r.radius)
@@ -581,7 +585,7 @@ void write_csv(const std::string& path, const std::vector<ShootingGroup>& groups
   fmt::print(f,
              "section,case,n,method,exact_tangent,solver,repeats,setup_seconds,seconds,cpu_seconds,"
              "converged,"
-             "iterations,evaluations,krylov_products,residual,spectral_radius,multipliers,"
+             "iterations,evaluations,tangent_replays,krylov_products,residual,spectral_radius,multipliers,"
              "multipliers_converged,stable,brute_status,brute_periods,brute_difference,"
              "brute_distance,brute_more_periods,brute_seconds,brute_cpu_seconds,brute_over_shooting,"
              "theta_start,"
@@ -598,11 +602,11 @@ void write_csv(const std::string& path, const std::vector<ShootingGroup>& groups
                               !(r.multipliers_converged && !r.stable);
       const std::string ratio = comparable ? fmt::format("{:.6g}", b.seconds / r.seconds) : "";
       fmt::print(f,
-                 "shooting,{},{},{},{},{},{},{:.6g},{:.6g},{:.6g},{},{},{},{},{:.3e},{:.10g},{},{},{},"
+                 "shooting,{},{},{},{},{},{},{:.6g},{:.6g},{:.6g},{},{},{},{},{},{:.3e},{:.10g},{},{},{},"
                  "{},{},{:.3e},{:.3e},{:.4g},{:.6g},{:.6g},{},,,,,,,,\n",
                  csv_quoted(r.case_label), r.masses, r.method, r.exact_tangent ? 1 : 0,
                  orbits::shooting_solver_name(r.solver), r.repeats, r.setup, r.seconds, r.cpu,
-                 r.converged ? 1 : 0, r.iterations, r.evaluations, r.krylov_products, r.residual,
+                 r.converged ? 1 : 0, r.iterations, r.evaluations, r.replays, r.krylov_products, r.residual,
                  r.radius, r.multipliers, r.multipliers_converged ? 1 : 0,
                  !r.converged ? "" : !r.multipliers_converged ? "undetermined" : r.stable ? "yes" : "no",
                  status, b.periods, b.difference, b.distance, b.more_periods, b.seconds, b.cpu,
@@ -616,7 +620,7 @@ void write_csv(const std::string& path, const std::vector<ShootingGroup>& groups
                           orbits::bifurcation_name(bif.type), bif.parameter);
     }
     fmt::print(f,
-               "continuation,{},{},{},{},dense,{},,{:.6g},{:.6g},{},,,,,,,,,,,,,,,,,{:.10g},{:.10g},"
+               "continuation,{},{},{},{},dense,{},,{:.6g},{:.6g},{},,,,,,,,,,,,,,,,,,{:.10g},{:.10g},"
                "{:.10g},{:.10g},{},{},{:.6g},{}\n",
                csv_quoted(r.label), r.masses, r.method, r.exact_tangent ? 1 : 0, r.repeats,
                r.seconds, r.cpu, r.failure.empty() ? 1 : 0, r.start, r.end, r.lowest, r.highest,

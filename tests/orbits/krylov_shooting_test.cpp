@@ -76,6 +76,49 @@ TEST_CASE("Newton-Krylov and dense Newton find the same periodic orbit of a 50-m
   CHECK(krylov.stable());
 }
 
+TEST_CASE("Newton-Krylov on the banded switching PIM replays its tangent products", "[orbits]") {
+  // The 50-mass chain by the banded switching PIM, whose tangent map the stroboscopic map records
+  // on a Krylov method's first product and replays for the next ones from the same state: dense
+  // Newton (whole monodromies, never replayed) and Newton-Krylov must land on the same orbit, with
+  // the same leading multipliers, and the replays must have replaced most integrations.
+  NondimensionalChain chain;
+  chain.masses = 50;
+  chain.alpha = {2.0};
+  chain.gap = {0.0};
+  chain.amplitude = {1.0};
+  chain.theta = 1.5;
+  Eigen::setNbThreads(1);
+  const auto make = [&] {
+    return StroboscopicMap(analysis::PointCase(chain), MethodSettings{Method::pim_switching_banded},
+                           100);
+  };
+  StroboscopicMap dense_map = make(), krylov_map = make();
+  REQUIRE(krylov_map.exact_tangent());
+  REQUIRE(krylov_map.integrator().can_record_tangent());
+  const Vector seed = pwl::test::harmonic_response(krylov_map.structure(), chain.theta);
+  ShootingOptions options;
+  options.tolerance = 1e-12;
+  options.solver = ShootingSolver::dense;
+  const PeriodicOrbit dense = find_periodic_orbit(dense_map, seed, options);
+  CHECK(dense_map.tangent_replays() == 0);
+  options.solver = ShootingSolver::krylov;
+  options.arnoldi.count = 6;
+  const PeriodicOrbit krylov = find_periodic_orbit(krylov_map, seed, options);
+  const double difference = (krylov.state - dense.state).lpNorm<Eigen::Infinity>();
+  measured("banded switching PIM: krylov vs dense orbit", difference);
+  CHECK(difference <= 1e-9);
+  const std::vector<Complex> leading(dense.multipliers.values.begin(),
+                                     dense.multipliers.values.begin() + 6);
+  const double distance = set_distance(leading, krylov.multipliers.values);
+  measured("banded switching PIM: Arnoldi vs dense leading multipliers", distance);
+  CHECK(distance <= 1e-8);
+  measured("integrations", static_cast<double>(krylov_map.evaluations()));
+  measured("replayed products", static_cast<double>(krylov_map.tangent_replays()));
+  // Without replays every GMRES product would be an integration, besides Newton's residuals.
+  CHECK(krylov_map.tangent_replays() > krylov.krylov_products / 2);
+  CHECK(krylov_map.evaluations() < krylov.krylov_products);
+}
+
 TEST_CASE(
     "restarted Arnoldi finds the leading eigenvalues of a matrix built with them (orbit "
     "multipliers)",

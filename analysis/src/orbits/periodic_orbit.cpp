@@ -126,9 +126,15 @@ Vector shooting_residual(StroboscopicMap& map, const Arcs& arcs, const Vector& Y
   return G;
 }
 
+// The map's integrations and replayed tangent products so far.
+struct MapCounts {
+  long evaluations = 0, replays = 0;
+};
+MapCounts counts(const StroboscopicMap& map) { return {map.evaluations(), map.tangent_replays()}; }
+
 PeriodicOrbit finish(StroboscopicMap& map, const ShootingOptions& options, Vector state,
                      double residual, int iterations, bool dense, Matrix monodromy,
-                     long evaluations_before) {
+                     const MapCounts& before) {
   PeriodicOrbit orbit;
   orbit.state = std::move(state);
   orbit.period = options.period;
@@ -145,7 +151,8 @@ PeriodicOrbit finish(StroboscopicMap& map, const ShootingOptions& options, Vecto
       orbit.multipliers = orbit_multipliers(map, orbit.state, options);
     }
   }
-  orbit.evaluations = map.evaluations() - evaluations_before;
+  orbit.evaluations = map.evaluations() - before.evaluations;
+  orbit.tangent_replays = map.tangent_replays() - before.replays;
   return orbit;
 }
 
@@ -160,7 +167,7 @@ PeriodicOrbit find_periodic_orbit(StroboscopicMap& map, const Vector& guess,
     throw InputError(fmt::format("guess has {} components, the state {}", guess.size(), N));
   }
   if (!guess.allFinite()) throw InputError("guess is not finite");
-  const long evaluations_before = map.evaluations();
+  const MapCounts before = counts(map);
   const bool dense = uses_dense_solver(map, options);
   const auto converged = [&](double residual, const Vector& y) {
     return residual <= options.tolerance * std::max(1.0, inf_norm(y));
@@ -191,7 +198,7 @@ PeriodicOrbit find_periodic_orbit(StroboscopicMap& map, const Vector& guess,
         Matrix monodromy = M[0];
         for (int i = 1; i < arcs.count; ++i) monodromy = M[i] * monodromy;
         return finish(map, options, Y.head(N), residual, iteration, true, std::move(monodromy),
-                      evaluations_before);
+                      before);
       }
       if (iteration == options.max_iterations) throw fail("did not converge", residual, iteration);
       Matrix J = Matrix::Zero(size, size);
@@ -230,7 +237,7 @@ PeriodicOrbit find_periodic_orbit(StroboscopicMap& map, const Vector& guess,
           Matrix monodromy = M[0];
           for (int i = 1; i < arcs.count; ++i) monodromy = M[i] * monodromy;
           return finish(map, options, Y.head(N), residual, iteration, true, std::move(monodromy),
-                        evaluations_before);
+                        before);
         }
         throw fail("stalled (no damped step decreases the residual)", residual, iteration);
       }
@@ -249,7 +256,7 @@ PeriodicOrbit find_periodic_orbit(StroboscopicMap& map, const Vector& guess,
   double residual = inf_norm(F);
   const auto krylov_answer = [&](int iteration) {
     PeriodicOrbit orbit =
-        finish(map, options, y, residual, iteration, false, Matrix(), evaluations_before);
+        finish(map, options, y, residual, iteration, false, Matrix(), before);
     orbit.krylov_products = krylov_products;
     orbit.preconditioned = preconditioner && preconditioner->available();
     return orbit;

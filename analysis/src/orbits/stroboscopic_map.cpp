@@ -19,6 +19,7 @@ StroboscopicMap::StroboscopicMap(const analysis::PointCase& point, const MethodS
   }
   settings_ = settings.for_period(point.period, steps_per_period);
   integrator_ = make_integrator(point_.structure, settings_);
+  if (integrator_->can_record_tangent()) integrator_->record_tangent(true);
 }
 
 StroboscopicMap::~StroboscopicMap() = default;
@@ -35,6 +36,12 @@ Vector StroboscopicMap::integrate(const Vector& y, double t0, double t1, Matrix*
   }
   if (!y.allFinite()) throw InputError("state is not finite");
   if (!(t1 > t0)) throw InputError(fmt::format("arc end {} must follow its start {}", t1, t0));
+  if (tangent != nullptr && replay_ready_ && t0 == base_t0_ && t1 == base_t1_ &&
+      y == base_start_ && integrator_->replay_tangent(*tangent)) {
+    ++replays_;
+    return base_end_;
+  }
+  replay_ready_ = false;
   integrator_->set_state(t0, y.head(n), y.tail(n));
   if (tangent != nullptr) {
     integrator_->advance_with_tangent(t1, *tangent);
@@ -44,6 +51,13 @@ Vector StroboscopicMap::integrate(const Vector& y, double t0, double t1, Matrix*
   ++evaluations_;
   Vector out(2 * n);
   out << integrator_->position(), integrator_->velocity();
+  if (tangent != nullptr && integrator_->can_record_tangent()) {
+    base_start_ = y;
+    base_end_ = out;
+    base_t0_ = t0;
+    base_t1_ = t1;
+    replay_ready_ = true;
+  }
   return out;
 }
 

@@ -12,4 +12,10 @@ void Integrator::advance_with_tangent(double, Matrix&, const StepObserver&) {
 
 bool Integrator::has_tangent_map() const { return method_traits(method()).tangent_map; }
 
+void Integrator::record_tangent(bool on) {
+  if (on) throw InputError(name() + " cannot record its tangent map for replay");
+}
+
+bool Integrator::replay_tangent(Matrix&) { return false; }
+
 }  // namespace pwl

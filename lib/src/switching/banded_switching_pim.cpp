@@ -112,6 +112,7 @@ struct LoadTerm {
 class BandedStepper final : public SwitchingPim,
                             private switching_detail::ModeSeries<BandedStepper, Vector, Vector> {
   friend switching_detail::ModeSeries<BandedStepper, Vector, Vector>;
+  using TangentOp = switching_detail::ModeSeries<BandedStepper, Vector, Vector>::TangentOp;
   static constexpr const char* kMethodName = "pim-switching-banded";
 
  public:
@@ -246,6 +247,7 @@ class BandedStepper final : public SwitchingPim,
     x_scale_ = x.cwiseAbs().maxCoeff();
     lcp_synced_ = false;
     sync();
+    this->begin_record();
   }
 
   void advance_to(double t_end, const StepObserver& observer) override {
@@ -258,8 +260,15 @@ class BandedStepper final : public SwitchingPim,
     this->advance_steps(t_end, &tangent, observer);
   }
 
+  // Tangent replay (integrator.hpp): the record of ModeSeries, with the smooth steps' linear part
+  // applied by tangent_smooth_step() as in step_with_tangent().
+  bool can_record_tangent() const override { return true; }
+  void record_tangent(bool on) override { this->set_recording(on); }
+  bool replay_tangent(Matrix& tangent) override { return this->replay(tangent); }
+
  private:
   void set_mode(Index j, bool on) {
+    if ((mode_[j] > 0.0) != on) this->note_mode(j, on);
     mode_[j] = on ? 1.0 : 0.0;
     signs_[j] = on ? 1.0 : -1.0;
   }
@@ -296,14 +305,28 @@ class BandedStepper final : public SwitchingPim,
   // (ModeSeries::tangent_piece); a smooth step is affine in the start state for the mode it
   // starts in and the LCP's active set, and tangent_smooth_step() applies its linear part after it.
   void step_with_tangent() {
+    replay_step_start();
+    this->note({TangentOp::Kind::step_start});
+    const long before = diagnostics_.switching_steps;
+    step();
+    if (diagnostics_.switching_steps == before) {
+      tangent_smooth_step();
+      this->note({TangentOp::Kind::smooth_step});
+    }
+  }
+
+  // The hooks of ModeSeries::replay: the mode a step starts in, and a smooth step's linear part
+  // with the touching springs of the mode it ends in (what step() left in acting_).
+  void replay_step_start() {
     start_mode_ = mode_;
     start_acting_.clear();
     for (Index j = 0; j < m_; ++j) {
       if (mode_[j] > 0.0) start_acting_.push_back(static_cast<int>(j));
     }
-    const long before = diagnostics_.switching_steps;
-    step();
-    if (diagnostics_.switching_steps == before) tangent_smooth_step();
+  }
+  void replay_smooth_step() {
+    collect_acting();
+    tangent_smooth_step();
   }
 
   // The linear part of a smooth step applied to each tangent column: the step's formula with the

@@ -179,22 +179,123 @@ class ModeSeries {
       throw InputError(fmt::format("tangent has {} rows; the state [x; x'] has {}",
                                    tangent->rows(), 2 * st.n_));
     }
+    if (tangent == nullptr) end_record();  // a stretch without the tangent: no replay
     tangent_ = tangent;
     struct Release {
       Matrix*& tangent;
       ~Release() { tangent = nullptr; }
     } release{tangent_};
-    detail::advance_on_grid(
-        t_end, st.time(), st.eta_, observer, st.position_, st.velocity_,
-        [&st, tangent] {
-          if (tangent != nullptr) {
-            st.step_with_tangent();
-          } else {
-            st.step();
-          }
-          return st.time();
-        },
-        [&st] { st.sync(); });
+    const bool extending = record_open_;
+    record_complete_ = false;
+    try {
+      detail::advance_on_grid(
+          t_end, st.time(), st.eta_, observer, st.position_, st.velocity_,
+          [&st, tangent] {
+            if (tangent != nullptr) {
+              st.step_with_tangent();
+            } else {
+              st.step();
+            }
+            return st.time();
+          },
+          [&st] { st.sync(); });
+    } catch (...) {
+      end_record();
+      throw;
+    }
+    record_complete_ = extending && record_open_;
+  }
+
+  // Tangent recording (Integrator::record_tangent, replay_tangent). The record lists what fixes
+  // the tangent map of the motion since set_state, in order: the springs' mode changes, the start
+  // of each step, each smooth step's linear part and each piece of a switching step (its step h,
+  // its series terms R and where it ends, σ). Replaying it from the mode at set_state repeats
+  // exactly the tangent arithmetic of advance_with_tangent, without the state's series, the
+  // search for switches or the LCP. A few entries per step and switch; beyond kRecordLimit
+  // entries the record is dropped (no replay) rather than grow without bound.
+  struct TangentOp {
+    enum class Kind : unsigned char { mode_on, mode_off, step_start, smooth_step, piece };
+    Kind kind = Kind::step_start;
+    int terms = 0;                // piece: R
+    Index spring = 0;             // mode_on, mode_off
+    double h = 0.0, sigma = 0.0;  // piece
+  };
+  static constexpr std::size_t kRecordLimit = std::size_t{1} << 22;  // 128 MiB of entries
+
+  void set_recording(bool on) {
+    recording_ = on;
+    if (!on) end_record();
+  }
+
+  // Called by the stepper's set_state once its modes are set.
+  void begin_record() {
+    end_record();
+    if (!recording_) return;
+    record_start_mode_ = self().mode_;
+    record_open_ = true;
+    record_complete_ = true;  // the identity, until a step is taken
+  }
+
+  void end_record() {
+    record_open_ = false;
+    record_complete_ = false;
+    record_.clear();
+  }
+
+  // Appends to an open record while advance_with_tangent runs (not while replaying).
+  void note(const TangentOp& op) {
+    if (!record_open_ || replaying_ || tangent_ == nullptr) return;
+    if (record_.size() >= kRecordLimit) {
+      end_record();
+      record_.shrink_to_fit();
+      return;
+    }
+    record_.push_back(op);
+  }
+  void note_mode(Index j, bool on) {
+    TangentOp op;
+    op.kind = on ? TangentOp::Kind::mode_on : TangentOp::Kind::mode_off;
+    op.spring = j;
+    note(op);
+  }
+
+  // The recorded tangent map applied to `tangent`; false without a complete record. The stepper
+  // provides replay_step_start() (what step_with_tangent notes before a step) and
+  // replay_smooth_step() (a smooth step's linear part, as the step applied it).
+  bool replay(Matrix& tangent) {
+    Stepper& st = self();
+    if (!record_complete_) return false;
+    if (tangent.rows() != 2 * st.n_) {
+      throw InputError(fmt::format("tangent has {} rows; the state [x; x'] has {}",
+                                   tangent.rows(), 2 * st.n_));
+    }
+    const Force end_mode = st.mode_;
+    struct Restore {
+      ModeSeries& series;
+      Stepper& stepper;
+      const Force& mode;
+      ~Restore() {
+        for (Index j = 0; j < stepper.m_; ++j) stepper.set_mode(j, mode[j] > 0.0);
+        series.tangent_ = nullptr;
+        series.replaying_ = false;
+      }
+    } restore{*this, st, end_mode};
+    replaying_ = true;
+    tangent_ = &tangent;
+    for (Index j = 0; j < st.m_; ++j) st.set_mode(j, record_start_mode_[j] > 0.0);
+    for (const TangentOp& op : record_) {
+      switch (op.kind) {
+        case TangentOp::Kind::mode_on: st.set_mode(op.spring, true); break;
+        case TangentOp::Kind::mode_off: st.set_mode(op.spring, false); break;
+        case TangentOp::Kind::step_start: st.replay_step_start(); break;
+        case TangentOp::Kind::smooth_step: st.replay_smooth_step(); break;
+        case TangentOp::Kind::piece:
+          st.begin_piece();
+          tangent_piece(op.h, op.terms, op.sigma);
+          break;
+      }
+    }
+    return true;
   }
 
   // Sizes the series buffers for `terms` terms, n degrees of freedom and m springs.
@@ -382,14 +483,21 @@ class ModeSeries {
       const event_detail::SearchResult& r =
           locator_.find_first_crossing(poly_, start_, 1.0, settings_);
       st.diagnostics_.gap_samples += r.samples;
+      const double sigma = r.found ? r.at.t : 1.0;
+      evaluate_series(R, sigma);
+      if (tangent_ != nullptr) {
+        tangent_piece(h, R, sigma);
+        TangentOp op;
+        op.kind = TangentOp::Kind::piece;
+        op.terms = R;
+        op.h = h;
+        op.sigma = sigma;
+        note(op);
+      }
       if (r.found) {
-        evaluate_series(R, r.at.t);
-        if (tangent_ != nullptr) tangent_piece(h, R, r.at.t);
         s = r.at.t >= 1.0 && whole ? st.eta_ : s + r.at.t * h;
         for (Index j : r.springs) toggle(j);
       } else {
-        evaluate_series(R, 1.0);
-        if (tangent_ != nullptr) tangent_piece(h, R, 1.0);
         s = whole ? st.eta_ : s + h;
       }
       xs_[0].swap(vx_);
@@ -464,6 +572,10 @@ class ModeSeries {
   event_detail::GapSample start_;
   event_detail::SearchSettings settings_;
   std::vector<Index> flip_;
+  // The tangent record (see TangentOp).
+  bool recording_ = false, record_open_ = false, record_complete_ = false, replaying_ = false;
+  std::vector<TangentOp> record_;
+  Force record_start_mode_;
 };
 
 }  // namespace pwl::switching_detail

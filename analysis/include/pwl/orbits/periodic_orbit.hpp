@@ -75,6 +75,7 @@ struct PeriodicOrbit {
   double residual = 0.0;         // |φ_{kT}(y) − y|_∞ at the answer
   int iterations = 0;            // Newton iterations
   long evaluations = 0;          // integrations of the map (k periods each, tangent included)
+  long tangent_replays = 0;      // tangent products replayed, not integrated (StroboscopicMap)
   bool exact_tangent = true;     // multipliers from the exact tangent (else forward differences)
   ShootingSolver solver = ShootingSolver::dense;  // the one used
   long krylov_products = 0;      // Krylov: products with M − I in GMRES, over all iterations

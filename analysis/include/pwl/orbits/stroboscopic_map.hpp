@@ -19,6 +19,14 @@
 // products of D. A. Knoll and D. E. Keyes, J. Comput. Phys. 193 (2004) 357-397), which are about
 // eight digits accurate and make Newton converge all the same, but give Floquet multipliers to
 // only about that accuracy. `exact_tangent()` says which.
+//
+// Repeated products. Krylov methods (the GMRES of Newton-Krylov shooting, Arnoldi for the
+// multipliers) multiply many vectors by one Jacobian, each product a tangent integration from the
+// same state. When the integrator can record its tangent map (Integrator::can_record_tangent: the
+// banded switching PIM) the map records it on the first product and replays it for the next ones
+// from the same state over the same span, without integrating the state again; the products are
+// the same to the last bit. A plain evaluation, another state or span, or a caller that takes the
+// integrator ends the record.
 #include <memory>
 
 #include "pwl/integrators/integrator.hpp"
@@ -63,12 +71,17 @@ class StroboscopicMap {
   Vector advance_with_jacobian(const Vector& y, int periods, Matrix& jacobian);
 
   // The integrator, for a caller that samples the motion along the orbit (orbit_profile). Its
-  // state is whatever the last evaluation left.
-  Integrator& integrator() { return *integrator_; }
+  // state is whatever the last evaluation left; the next tangent product integrates again.
+  Integrator& integrator() {
+    replay_ready_ = false;
+    return *integrator_;
+  }
 
   // Evaluations of the map so far (each one an integration of `periods` periods; the forward
-  // differences count one per column).
+  // differences count one per column). Replayed tangent products are not integrations: they are
+  // counted by tangent_replays().
   long evaluations() const { return evaluations_; }
+  long tangent_replays() const { return replays_; }
 
  private:
   Vector integrate(const Vector& y, double t0, double t1, Matrix* tangent);
@@ -78,6 +91,11 @@ class StroboscopicMap {
   int steps_per_period_ = 0;
   std::unique_ptr<Integrator> integrator_;
   long evaluations_ = 0;
+  long replays_ = 0;
+  // The last tangent integration, whose record the integrator holds: its start, span and end.
+  bool replay_ready_ = false;
+  Vector base_start_, base_end_;
+  double base_t0_ = 0.0, base_t1_ = 0.0;
 };
 
 }  // namespace pwl::orbits

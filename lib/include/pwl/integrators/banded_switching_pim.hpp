@@ -44,6 +44,14 @@
 // solve a band LU of M_AA (refactorised only from the first index where the active set changed),
 // and a piece of a switching step its Taylor terms; O(n q) per column and step, nothing 2n x 2n.
 //
+// Tangent replay (Integrator::record_tangent, replay_tangent): while recording, the stepper notes
+// what fixes its tangent map (each step's start, its smooth steps, the pieces of its switching
+// steps with their lengths and series terms, the springs' mode changes) and applies that record
+// again to other columns without the state's series, the search for switches or the LCP. The
+// columns come out as advance_with_tangent gives them, to the last bit. On the 1000-mass chain of
+// `pwl bench orbits`, whose springs switch about 2000 times a period, a replayed product costs
+// about a third of an integration with its tangent.
+//
 // References: W. X. Zhong and F. W. Williams, Proc. IMechE C 208 (1994) 427-430 (precise
 // integration); He Dongdong, Gao Qiang and Zhong Wanxie, Appl. Math. Mech. 39(7) (2018) 737-749
 // (the banded exponential of periodic structures); C. F. Van Loan, IEEE TAC 23 (1978) 395-404

@@ -55,6 +55,26 @@ class Integrator {
   // Whether advance_with_tangent is implemented (false: it throws): the tangent_map column of this
   // method's row of the method table.
   bool has_tangent_map() const;
+
+  // Tangent replay. The tangent map of a piecewise-linear motion is a product of linear maps that
+  // the base motion fixes (its modes, the times of its switches, its active sets). An integrator
+  // that can record them while advance_with_tangent runs applies them again to other columns
+  // without integrating the state, so that many products with one monodromy (the Krylov products
+  // of Newton-Krylov shooting, Arnoldi's) cost only the tangent's own arithmetic, which on a long
+  // chain full of contacts is a fraction of the step's (the switch search is not repeated). The
+  // replayed columns equal what advance_with_tangent gives them, to the last bit.
+  //
+  // Recording is off by default: the record grows with the run. While it is on, set_state starts
+  // a new record, each advance_with_tangent extends it, and advance_to (or a run that throws)
+  // ends it. Integrators without it answer false and ignore record_tangent(false).
+  virtual bool can_record_tangent() const { return false; }
+  // Throws InputError when asked to record without can_record_tangent().
+  virtual void record_tangent(bool on);
+  // Applies the tangent map of the motion from the last set_state to time(), as recorded, to
+  // `tangent` (2n x p); leaves the state alone. False (and `tangent` untouched) when there is no
+  // complete record: recording off, an advance_to since set_state, or a record that outgrew its
+  // limit.
+  virtual bool replay_tangent(Matrix& tangent);
 };
 
 }  // namespace pwl
