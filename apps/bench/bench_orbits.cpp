@@ -6,7 +6,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <complex>
 #include <cstdio>
+#include <limits>
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -42,6 +44,9 @@ struct OrbitBenchOptions {
   std::vector<std::string> cases;     // only these (keys below); empty: all
   std::string out = "out/bench";
   bool quiet = false;
+  // After Newton-Krylov, form the whole monodromy at its orbit and compare its eigenvalues with
+  // Arnoldi's (the independent check of the large chain's verdict; 2n tangent columns).
+  bool check_multipliers = false;
 };
 
 // Keys of --cases.
@@ -128,6 +133,7 @@ struct ShootingRow {
   double arnoldi_residual = 0.0;
   bool stable = false;
   Vector state;
+  std::vector<std::complex<double>> leading;  // the multipliers found (Arnoldi's or all)
 };
 
 struct BruteForce {
@@ -147,10 +153,22 @@ struct BruteForce {
   int repeats = 0;
 };
 
+// The whole monodromy at a Newton-Krylov orbit against Arnoldi's leading multipliers.
+struct MultiplierCheck {
+  bool ran = false;
+  double form_seconds = 0.0, eigen_seconds = 0.0;
+  Index size = 0;
+  int outside = 0;        // eigenvalues of the monodromy outside the unit circle
+  double radius = 0.0;    // its spectral radius
+  double distance = 0.0;  // the farthest of Arnoldi's values from the monodromy's nearest leading one
+  int compared = 0;
+};
+
 struct ShootingGroup {
   ShootingCase spec;
   std::vector<ShootingRow> rows;
   BruteForce brute;
+  MultiplierCheck check;
 };
 
 std::string stable_text(const ShootingRow& r) {
@@ -231,6 +249,36 @@ orbits::StroboscopicMap make_map(const ShootingCase& c, int steps_per_period) {
   return orbits::StroboscopicMap(analysis::PointCase(c.chain), settings, steps_per_period);
 }
 
+void check_multipliers(ShootingGroup& g, const std::function<void(const std::string&)>& say) {
+  const ShootingRow* krylov = nullptr;
+  for (const ShootingRow& r : g.rows) {
+    if (r.converged && r.solver == ShootingSolver::krylov && !r.leading.empty()) krylov = &r;
+  }
+  if (krylov == nullptr) return;
+  MultiplierCheck& c = g.check;
+  say(fmt::format("{}, n = {}: the whole monodromy at the Newton-Krylov orbit ...", g.spec.label,
+                  g.spec.chain.masses));
+  orbits::StroboscopicMap map = make_map(g.spec, 200);
+  const Stopwatch form;
+  Matrix M;
+  map.advance_with_jacobian(krylov->state, 1, M);
+  c.form_seconds = form.wall_seconds();
+  const Stopwatch eigen;
+  const orbits::FloquetMultipliers all = orbits::floquet_multipliers(M);
+  c.eigen_seconds = eigen.wall_seconds();
+  c.ran = true;
+  c.size = M.rows();
+  c.outside = all.unstable_count();
+  c.radius = all.largest_modulus();
+  c.compared = static_cast<int>(krylov->leading.size());
+  const std::size_t pool = std::min(all.values.size(), krylov->leading.size() + 2);
+  for (const std::complex<double>& mu : krylov->leading) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < pool; ++i) nearest = std::min(nearest, std::abs(mu - all.values[i]));
+    c.distance = std::max(c.distance, nearest);
+  }
+}
+
 void run_shooting(ShootingGroup& g, const OrbitBenchOptions& o,
                   const std::function<void(const std::string&)>& say) {
   constexpr int kSteps = 200;  // per forcing period (fixed-grid methods)
@@ -279,6 +327,7 @@ void run_shooting(ShootingGroup& g, const OrbitBenchOptions& o,
         row.arnoldi_residual = orbit.multipliers.residual;
         row.stable = orbit.stable();
         row.state = orbit.state;
+        row.leading = orbit.multipliers.values;
       } catch (const orbits::ShootingError& e) {
         times.push_back(watch.wall_seconds());
         cpus.push_back(watch.cpu_seconds_since());
@@ -295,6 +344,8 @@ void run_shooting(ShootingGroup& g, const OrbitBenchOptions& o,
     row.cpu = median(cpus);
     g.rows.push_back(std::move(row));
   }
+
+  if (o.check_multipliers) check_multipliers(g, say);
 
   // The competitor: the same integrator from the same guess, period after period.
   const ShootingRow* orbit = nullptr;
@@ -531,6 +582,15 @@ std::string format_tables(const OrbitBenchOptions& o, const std::vector<Shooting
             krylov->seconds, inf_norm(dense->state - krylov->state),
             std::abs(dense->radius - krylov->radius));
       }
+      if (g.check.ran) {
+        const MultiplierCheck& c = g.check;
+        t += fmt::format(
+            "\n{}, n = {}: the whole {} x {} monodromy at the Newton-Krylov orbit ({:.3g} s to form, "
+            "{:.3g} s for its eigenvalues): {} outside the unit circle, ρ(M) = {:.9g}; Arnoldi's "
+            "{} leading multipliers are its leading ones to {:.1e}.\n",
+            g.spec.label, g.spec.chain.masses, c.size, c.size, c.form_seconds, c.eigen_seconds,
+            c.outside, c.radius, c.compared, c.distance);
+      }
       for (const ShootingRow& r : g.rows) {
         if (!r.exact_tangent) {
           t += fmt::format(
@@ -726,6 +786,9 @@ void add_orbits_bench(CLI::App& bench) {
   c->add_flag("--quick", o->quick,
               "A smoke run: chains of 10 and 100 masses, small budgets, 20-point branches, one run "
               "unless --repeats");
+  c->add_flag("--check-multipliers", o->check_multipliers,
+              "After Newton-Krylov, form the whole monodromy at its orbit (2n tangent columns) and "
+              "compare its eigenvalues with Arnoldi's leading multipliers");
   c->add_option("--transient", o->transient, "Periods from rest to the common guess")
       ->check(non_negative_number());
   c->add_option("--tol", o->tolerance, "Tolerance of shooting and of brute-force settling")

@@ -119,6 +119,63 @@ TEST_CASE("Newton-Krylov on the banded switching PIM replays its tangent product
   CHECK(krylov_map.evaluations() < krylov.krylov_products);
 }
 
+TEST_CASE("thick-restarted Arnoldi resolves long-wave multipliers crowded against 1",
+          "[orbits]") {
+  // A = S D S⁻¹ of size 1000 with the spectrum of a long chain's orbit: the long-wave modes crowd
+  // against μ = 1, μ_k = (1 − 4e-6 k²) e^{±0.0131 k i} for k = 1 .. 200 (the law the 1000-mass
+  // chain of `pwl bench orbits` follows, where the dense monodromy's leading pairs are 0.999996,
+  // 0.999984, 0.999964 at angles 0.0131, 0.0262, 0.0393), the other 600 in a disc of radius 0.9;
+  // S a random well-conditioned basis. The default options must find the leading six; a basis of
+  // 60 vectors, restarted as often, must not have converged (why the default is larger).
+  const Index n = 1000;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Matrix D = Matrix::Zero(n, n);
+  const auto pair = [&](Index i, double r, double phi) {
+    D(i, i) = D(i + 1, i + 1) = r * std::cos(phi);
+    D(i, i + 1) = r * std::sin(phi);
+    D(i + 1, i) = -r * std::sin(phi);
+  };
+  std::vector<Complex> expected;
+  for (int k = 1; k <= 200; ++k) {
+    const double r = 1.0 - 4e-6 * k * k, phi = 0.0131 * k;
+    pair(2 * (k - 1), r, phi);
+    if (k <= 3) {
+      expected.push_back(std::polar(r, phi));
+      expected.push_back(std::polar(r, -phi));
+    }
+  }
+  for (Index i = 400; i + 1 < n; i += 2) pair(i, 0.9 * std::abs(u(rng)), 3.2 * u(rng));
+  Matrix random(n, n);
+  for (Index i = 0; i < n; ++i)
+    for (Index j = 0; j < n; ++j) random(i, j) = u(rng);
+  const Matrix Q = Eigen::HouseholderQR<Matrix>(random).householderQ();
+  const Matrix S = Q * (Matrix::Identity(n, n) + 0.05 * random / std::sqrt(double(n)));
+  const Matrix A = S * D * S.inverse();
+  long products = 0;
+  const auto apply = [&](Matrix& v) {
+    products += v.cols();
+    v = A * v;
+  };
+  ArnoldiOptions options;
+  options.count = 6;
+  const FloquetMultipliers found = leading_floquet_multipliers(apply, n, options);
+  measured("crowded multipliers: residual", found.residual);
+  measured("crowded multipliers: products", static_cast<double>(products));
+  CHECK(found.converged);
+  const double distance = set_distance(expected, found.values);
+  measured("crowded multipliers: error", distance);
+  CHECK(distance <= 1e-9);
+  CHECK(found.largest_modulus() == Approx(1.0 - 4e-6).epsilon(1e-12));
+  CHECK(found.stable());
+  options.krylov_dimension = 60;
+  products = 0;
+  const FloquetMultipliers small = leading_floquet_multipliers(apply, n, options);
+  measured("crowded multipliers, 60 vectors: residual", small.residual);
+  measured("crowded multipliers, 60 vectors: products", static_cast<double>(products));
+  CHECK_FALSE(small.converged);
+}
+
 TEST_CASE(
     "restarted Arnoldi finds the leading eigenvalues of a matrix built with them (orbit "
     "multipliers)",

@@ -1,6 +1,7 @@
 #include "pwl/orbits/floquet_multipliers.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
@@ -88,12 +89,15 @@ FloquetMultipliers leading_floquet_multipliers(const std::function<void(Matrix&)
 
   FloquetMultipliers result;
   result.complete = wanted == size;
+  // The Krylov-Schur relation A V_j = V_j G_j + g v_{j+1} e_j^T, G upper Hessenberg except, after
+  // a restart, the row under the kept block.
+  Matrix V = Matrix::Zero(size, m + 1);
+  Matrix G = Matrix::Zero(m + 1, m);
+  V.col(0) = start / start.norm();
+  int kept = 0;  // columns carried over from the last cycle
   for (int restart = 0; restart <= options.max_restarts; ++restart) {
-    Matrix V = Matrix::Zero(size, m + 1);
-    Matrix H = Matrix::Zero(m + 1, m);
-    V.col(0) = start / start.norm();
     int built = m;
-    for (int j = 0; j < m; ++j) {
+    for (int j = kept; j < m; ++j) {
       Matrix w = V.col(j);
       apply(w);
       // Modified Gram-Schmidt, twice (re-orthogonalisation keeps the basis orthonormal to
@@ -101,47 +105,76 @@ FloquetMultipliers leading_floquet_multipliers(const std::function<void(Matrix&)
       for (int pass = 0; pass < 2; ++pass) {
         for (int i = 0; i <= j; ++i) {
           const double h = V.col(i).dot(w.col(0));
-          H(i, j) += h;
+          G(i, j) += h;
           w.col(0) -= h * V.col(i);
         }
       }
       const double beta = w.col(0).norm();
-      H(j + 1, j) = beta;
-      if (beta <= 1e-14 * H.col(j).head(j + 1).norm() || j + 1 == size) {
+      G(j + 1, j) = beta;
+      if (beta <= 1e-14 * G.col(j).head(j + 1).norm() || j + 1 == size) {
         built = j + 1;  // an invariant subspace: its Ritz values are exact
         break;
       }
       V.col(j + 1) = w.col(0) / beta;
     }
-    const Matrix Hm = H.topLeftCorner(built, built);
-    Eigen::EigenSolver<Matrix> eig(Hm);
-    if (eig.info() != Eigen::Success) throw Error("arnoldi: the Hessenberg eigenproblem failed");
+    const Matrix Gm = G.topLeftCorner(built, built);
+    Eigen::EigenSolver<Matrix> eig(Gm);
+    if (eig.info() != Eigen::Success) throw Error("arnoldi: the Ritz eigenproblem failed");
     std::vector<int> order(built);
     for (int i = 0; i < built; ++i) order[i] = i;
     std::sort(order.begin(), order.end(), [&](int a, int b) {
       return std::abs(eig.eigenvalues()(a)) > std::abs(eig.eigenvalues()(b));
     });
-    const double beta = built < H.rows() ? H(built, built - 1) : 0.0;
+    // Residual of the Ritz pair (θ, V s): |g| |s_last| / |s|, g the last Arnoldi step's.
+    const double beta = built < G.rows() ? G(built, built - 1) : 0.0;
     const double scale = std::max(1.0, std::abs(eig.eigenvalues()(order[0])));
+    const auto residual_of = [&](int i) {
+      const Eigen::VectorXcd s = eig.eigenvectors().col(i);
+      return std::abs(beta) * std::abs(s(built - 1)) / s.norm() / scale;
+    };
     double worst = 0;
     const int reported = std::min(wanted, built);
-    for (int r = 0; r < reported; ++r) {
-      const Eigen::VectorXcd s = eig.eigenvectors().col(order[r]);
-      worst = std::max(worst, std::abs(beta) * std::abs(s(built - 1)) / s.norm() / scale);
-    }
+    for (int r = 0; r < reported; ++r) worst = std::max(worst, residual_of(order[r]));
     result.values.clear();
     for (int r = 0; r < reported; ++r) result.values.push_back(eig.eigenvalues()(order[r]));
     result.residual = worst;
-    if (worst <= options.tolerance || built < m) break;
-    // Explicit restart from the sum of the wanted Ritz vectors (real and imaginary parts).
-    start.setZero();
-    for (int r = 0; r < reported; ++r) {
+    if (worst <= options.tolerance || built < m || restart == options.max_restarts) break;
+
+    // Thick restart (G. W. Stewart, SIAM J. Matrix Anal. Appl. 23 (2001) 601-614, Krylov-Schur;
+    // R. B. Morgan, Math. Comp. 65 (1996) 1213-1230): keep the span of the leading Ritz vectors,
+    // more of them than wanted, so that what the cycle learnt about the next ones is not thrown
+    // away. A real basis Z of that span (a complex pair gives its real and imaginary parts), Q
+    // its orthonormal basis: V Q spans an invariant subspace of the projected operator, with
+    // A (V Q) = (V Q) (Qᵀ G Q) + g v_{m+1} (e_mᵀ Q).
+    int keep = std::min(m - 1, std::max(wanted + (m - wanted) / 2, wanted));
+    Matrix Z(built, keep);
+    int columns = 0;
+    for (int r = 0; r < built && columns < keep; ++r) {
+      const std::complex<double> theta = eig.eigenvalues()(order[r]);
       const Eigen::VectorXcd s = eig.eigenvectors().col(order[r]);
-      const Eigen::VectorXcd z = V.leftCols(built).cast<std::complex<double>>() * s;
-      start += z.real() / std::max(z.real().norm(), 1e-300);
-      if (z.imag().norm() > 0) start += z.imag() / z.imag().norm();
+      if (theta.imag() == 0.0) {
+        Z.col(columns++) = s.real();
+      } else if (theta.imag() > 0.0) {
+        if (columns + 2 > keep) break;  // a pair is kept whole or not at all
+        Z.col(columns++) = s.real();
+        Z.col(columns++) = s.imag();
+      }
     }
-    if (!start.allFinite() || start.norm() == 0) break;
+    if (columns == 0) break;
+    const Eigen::HouseholderQR<Matrix> qr(Z.leftCols(columns));
+    const Matrix Q = qr.householderQ() * Matrix::Identity(built, columns);
+    const Matrix kept_basis = V.leftCols(built) * Q;
+    const Matrix projected = Q.transpose() * Gm * Q;
+    const Vector next = V.col(built);
+    const Eigen::RowVectorXd coupling = beta * Q.row(built - 1);
+    V.setZero();
+    G.setZero();
+    V.leftCols(columns) = kept_basis;
+    V.col(columns) = next;
+    G.topLeftCorner(columns, columns) = projected;
+    G.row(columns).head(columns) = coupling;
+    kept = columns;
+    if (!V.allFinite()) break;
   }
   result.converged = result.residual <= options.tolerance;
   sort_multipliers(result.values);

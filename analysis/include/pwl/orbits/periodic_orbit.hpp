@@ -17,7 +17,14 @@
 // many eigenvalues of M − I near 0, where GMRES alone needs about one product per mode; GMRES is
 // therefore right-preconditioned by the inverse of M0 − I of the structure with its springs open
 // (modal 2 x 2 blocks when the damping is classical: analysis/src/orbits/
-// open_structure_preconditioner.hpp), which clusters the spectrum near 1.
+// open_structure_preconditioner.hpp), which clusters the spectrum near 1. The products of one
+// Newton step (and Arnoldi's, at the answer) all start from one state: with an integrator that
+// records its tangent map (the banded switching PIM) only the first integrates, the others replay
+// it (stroboscopic_map.hpp). A product then costs the tangent's arithmetic, which grows with the
+// pieces the springs' switches cut the steps into: on the 1000-mass chain of `pwl bench orbits`
+// Newton's early iterates move whole stretches of the chain across the gaps (about 2000 switches
+// a period, 60-100 ms a replayed product) while the orbit itself switches 14 times a period
+// (about 6 ms).
 //
 // Multiple shooting. An orbit that is strongly unstable (|μ| ≫ 1) makes the single-shooting
 // Jacobian badly conditioned and its Newton basin tiny. With `shots` = m > 1 the k periods are cut
