@@ -20,6 +20,30 @@ using pwl::test::measured;
 using pwl::test::set_distance;
 using Complex = std::complex<double>;
 
+namespace {
+
+// The 2x2 rotation-scaling block of the pair r e^{±iφ}, at (i, i) of D.
+void put_pair(Matrix& D, Index i, double r, double phi) {
+  D(i, i) = D(i + 1, i + 1) = r * std::cos(phi);
+  D(i, i + 1) = r * std::sin(phi);
+  D(i + 1, i) = -r * std::sin(phi);
+}
+
+// S D S⁻¹ with S a random well-conditioned basis: an orthogonal Q bent by 5%, both from uniform
+// draws in [-1, 1] of `rng`.
+Matrix similar_to(const Matrix& D, std::mt19937& rng) {
+  const Index n = D.rows();
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Matrix random(n, n);
+  for (Index i = 0; i < n; ++i)
+    for (Index j = 0; j < n; ++j) random(i, j) = u(rng);
+  const Matrix Q = Eigen::HouseholderQR<Matrix>(random).householderQ();
+  const Matrix S = Q * (Matrix::Identity(n, n) + 0.05 * random / std::sqrt(double(n)));
+  return S * D * S.inverse();
+}
+
+}  // namespace
+
 TEST_CASE("Newton-Krylov and dense Newton find the same periodic orbit of a 50-mass chain",
           "[orbits]") {
   NondimensionalChain chain;
@@ -131,27 +155,17 @@ TEST_CASE("thick-restarted Arnoldi resolves long-wave multipliers crowded agains
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   Matrix D = Matrix::Zero(n, n);
-  const auto pair = [&](Index i, double r, double phi) {
-    D(i, i) = D(i + 1, i + 1) = r * std::cos(phi);
-    D(i, i + 1) = r * std::sin(phi);
-    D(i + 1, i) = -r * std::sin(phi);
-  };
   std::vector<Complex> expected;
   for (int k = 1; k <= 200; ++k) {
     const double r = 1.0 - 4e-6 * k * k, phi = 0.0131 * k;
-    pair(2 * (k - 1), r, phi);
+    put_pair(D, 2 * (k - 1), r, phi);
     if (k <= 3) {
       expected.push_back(std::polar(r, phi));
       expected.push_back(std::polar(r, -phi));
     }
   }
-  for (Index i = 400; i + 1 < n; i += 2) pair(i, 0.9 * std::abs(u(rng)), 3.2 * u(rng));
-  Matrix random(n, n);
-  for (Index i = 0; i < n; ++i)
-    for (Index j = 0; j < n; ++j) random(i, j) = u(rng);
-  const Matrix Q = Eigen::HouseholderQR<Matrix>(random).householderQ();
-  const Matrix S = Q * (Matrix::Identity(n, n) + 0.05 * random / std::sqrt(double(n)));
-  const Matrix A = S * D * S.inverse();
+  for (Index i = 400; i + 1 < n; i += 2) put_pair(D, i, 0.9 * std::abs(u(rng)), 3.2 * u(rng));
+  const Matrix A = similar_to(D, rng);
   long products = 0;
   const auto apply = [&](Matrix& v) {
     products += v.cols();
@@ -188,24 +202,14 @@ TEST_CASE(
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   Matrix D = Matrix::Zero(n, n);
   std::vector<Complex> expected;
-  const auto pair = [&](Index i, double r, double phi) {
-    D(i, i) = D(i + 1, i + 1) = r * std::cos(phi);
-    D(i, i + 1) = r * std::sin(phi);
-    D(i + 1, i) = -r * std::sin(phi);
-  };
-  pair(0, 0.98, 0.4);
+  put_pair(D, 0, 0.98, 0.4);
   D(2, 2) = -0.96;
-  pair(3, 0.93, 2.2);
+  put_pair(D, 3, 0.93, 2.2);
   D(5, 5) = 0.9;
   expected = {std::polar(0.98, 0.4), std::polar(0.98, -0.4), Complex(-0.96, 0),
               std::polar(0.93, 2.2), std::polar(0.93, -2.2), Complex(0.9, 0)};
-  for (Index i = 6; i + 1 < n; i += 2) pair(i, 0.8 * std::abs(u(rng)), 3.2 * u(rng));
-  Matrix random(n, n);
-  for (Index i = 0; i < n; ++i)
-    for (Index j = 0; j < n; ++j) random(i, j) = u(rng);
-  const Matrix Q = Eigen::HouseholderQR<Matrix>(random).householderQ();
-  const Matrix S = Q * (Matrix::Identity(n, n) + 0.05 * random / std::sqrt(double(n)));
-  const Matrix A = S * D * S.inverse();
+  for (Index i = 6; i + 1 < n; i += 2) put_pair(D, i, 0.8 * std::abs(u(rng)), 3.2 * u(rng));
+  const Matrix A = similar_to(D, rng);
   long products = 0;
   const auto apply = [&](Matrix& v) {
     products += v.cols();
