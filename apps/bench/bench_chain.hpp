@@ -1,9 +1,11 @@
 #pragma once
 // `pwl bench chain`: the paper's section 4.2 problem (He, Gao & Zhong 2018, Table 1; SPEC.md §5)
-// measured side by side: n = 1000 masses, t in [0, 200] s from rest, the banded PIM at the
-// paper's step and at the step its rule picks, the dense PIM, and dopri5 at 1e-5 and 1e-10, plain
-// (like the paper's ode45) and kink-located. For each: the median wall and CPU time of several
-// runs and the largest error of x1 and x1' against a kink-located reference at 1e-12.
+// measured side by side: n = 1000 masses, t in [0, 200] s from rest, every pwl configuration that
+// competes there (keys starting with "pim": the banded PIM at the paper's step and at the step its
+// rule picks, the banded switching PIM at a few steps, the dense PIM), and dopri5 at 1e-5 and
+// 1e-10, plain (like the paper's ode45) and kink-located. For each: the median wall and CPU time
+// of several runs and the largest error of x1 and x1' against a kink-located reference at 1e-12;
+// then, for each dopri5 row, the fastest pwl row at or below both its errors and how much faster.
 #include <optional>
 #include <string>
 #include <vector>
@@ -21,6 +23,9 @@ struct ChainBenchOptions {
   double paper_step = 0.02;    // s, the step the paper reports
   double wished_step = 0.32;   // s, η1 given to the step rule
   std::vector<int> rule_bands{5, 8};  // q given to the step rule (the paper: 5, its 11-dof piece)
+  // Steps of the banded switching PIM (order 5, switches located), one row each.
+  std::vector<double> switching_steps{0.1, 0.04, 0.02};
+  bool without_dense = false;         // leave the dense PIM out (minutes per run at n = 1000)
   double reference_tolerance = 1e-12;
   double reference_grid = 0.005;      // s, spacing of the reference's recorded points
   bool reference_check = true;        // a second reference (dopri5) to bound the first's error
@@ -31,7 +36,8 @@ struct ChainBenchOptions {
   bool quiet = false;
 };
 
-// Keys of the methods, in table order.
+// Keys of the methods, in table order. A key may name several rows (pim-rule: one per band,
+// pim-switching: one per step); their parameters tell them apart.
 std::vector<std::string> chain_bench_methods();
 
 struct ChainMethodResult {
