@@ -1,6 +1,6 @@
 # Figures go through a gnuplot-iostream session (apps/pwl/output/gnuplot.cpp). Three cases, run
 # with `cmake -DPWL=<pwl> -DWORK_DIR=<dir> -DSOURCE_DIR=<repo> -P figures.cmake`:
-#   1. a title holding quotes and gnuplot's own syntax reaches the figure as text;
+#   1. a title holding quotes and gnuplot's own syntax, or a line break, reaches the figure as text;
 #   2. without gnuplot on PATH the run still succeeds, writes its CSV, and says why there is no
 #      figure;
 #   3. a script that gnuplot rejects is reported as a failed figure (gnuplot's exit status is
@@ -37,6 +37,22 @@ if(at EQUAL -1)
 endif()
 if(EXISTS ${WORK_DIR}/injected)
   message(FATAL_ERROR "the title was run as a gnuplot command")
+endif()
+# A line break in the title would end gnuplot's command there and run the next line: it becomes a
+# space, and the line after it stays text.
+run_pwl(broken_line ${PWL} ${case}
+        --title "first line\nsystem(\"touch ${WORK_DIR}/injected_by_newline\")\r\n"
+        --out ${WORK_DIR}/broken_line)
+if(NOT broken_line_code EQUAL 0 OR NOT EXISTS ${WORK_DIR}/broken_line/phase.svg)
+  message(FATAL_ERROR "title with a line break: exit ${broken_line_code}: ${broken_line_stderr}")
+endif()
+if(EXISTS ${WORK_DIR}/injected_by_newline)
+  message(FATAL_ERROR "the line after a line break in the title was run as a gnuplot command")
+endif()
+file(READ ${WORK_DIR}/broken_line/phase.svg svg)
+string(FIND "${svg}" "first line system(" at)
+if(at EQUAL -1)
+  message(FATAL_ERROR "the title's line break did not become a space in phase.svg")
 endif()
 
 # 2. No gnuplot on PATH.

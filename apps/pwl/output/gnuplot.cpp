@@ -55,7 +55,16 @@ class IgnoredSigpipe {
 
 std::string gnuplot_quoted(const std::string& text) {
   std::string quoted = "'";
-  for (char c : text) quoted += c == '\'' ? std::string("''") : std::string(1, c);
+  for (const char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (c == '\'') {
+      quoted += "''";
+    } else if (byte < 0x20 || byte == 0x7f) {
+      quoted += ' ';
+    } else {
+      quoted += c;
+    }
+  }
   return quoted + "'";
 }
 

@@ -29,7 +29,9 @@ bool draw_figure_and_report(
     const std::function<std::string(const std::string& format)>& definitions,
     const std::string& stem, const std::string& who, bool quiet);
 
-// `text` as a gnuplot single-quoted string literal ('it''s'), for titles and paths.
+// `text` as a gnuplot single-quoted string literal ('it''s'), for titles and paths. gnuplot reads
+// its commands line by line, so a line break inside the literal would end the command there and
+// run the rest of the text as commands: control characters (line breaks, tabs, ...) become spaces.
 std::string gnuplot_quoted(const std::string& text);
 
 
