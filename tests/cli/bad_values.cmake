@@ -3,7 +3,8 @@
 # the flag and the value. One table, bad_values.csv, drives bad_values_test.cpp (a Catch2 program
 # of this folder, globbed with the others): it builds the program's command line as main.cpp does,
 # fails for a numeric flag without rows, and runs the real program on every row, a few at a time,
-# each with a time limit.
+# each with a time limit (under AddressSanitizer one row per job and flag, cycling through the
+# kinds of bad value: see rows_to_run()).
 target_link_libraries(bad_values_test PRIVATE pwl_bench pwl_app)
 target_compile_definitions(bad_values_test PRIVATE
                            PWL_EXECUTABLE="$<TARGET_FILE:pwl>"
