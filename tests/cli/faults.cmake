@@ -22,8 +22,14 @@ add_test(NAME cli_sweep_read_only_folder
                  ${PWL_CLI_OUT}/read_only_folder)
 set_tests_properties(cli_sweep_read_only_folder PROPERTIES SKIP_RETURN_CODE 77
                      PASS_REGULAR_EXPRESSION "read-only folders refused, nothing lost, resumed identical")
+# Points of 40000 forcing periods, 4000 under the sanitizers (the same second or so a point).
+if(PWL_SANITIZE)
+  set(PWL_STOP_SIGNALS_TRANSIENT 4000)
+else()
+  set(PWL_STOP_SIGNALS_TRANSIENT 40000)
+endif()
 add_test(NAME cli_sweep_stop_signals
          COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/stop_signals.sh $<TARGET_FILE:pwl>
-                 ${PWL_CLI_OUT}/stop_signals)
+                 ${PWL_CLI_OUT}/stop_signals ${PWL_STOP_SIGNALS_TRANSIENT})
 set_tests_properties(cli_sweep_stop_signals PROPERTIES SKIP_RETURN_CODE 77 TIMEOUT 600
                      PASS_REGULAR_EXPRESSION "stopped by SIGINT and SIGTERM, resumed, identical")

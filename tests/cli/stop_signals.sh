@@ -2,16 +2,17 @@
 # SIGINT and SIGTERM stop a sweep at once, even in the middle of long points on two OpenMP
 # threads: exit code 130 or 143, a message with the points done and how to go on, a journal of
 # whole, valid lines only; --resume then ends with the same files, byte for byte, as a run never
-# stopped. Usage: stop_signals.sh PWL OUTPUT_FOLDER
+# stopped. Usage: stop_signals.sh PWL OUTPUT_FOLDER [TRANSIENT]
 set -u
 pwl=$1
 out=$2
-# Points of 40000 forcing periods (about a second each in a Release build), two at a time. The
-# signal is sent just after a point is journaled, when that thread has begun a new point: a stop
-# that waited for the points in progress would take about a point's time; it must take less than
-# a quarter of it.
+transient=${3:-40000}
+# Points of TRANSIENT forcing periods (40000: about a second each in a Release build; the
+# sanitizer build, about 20 times slower, passes 4000), two at a time. The signal is sent just
+# after a point is journaled, when that thread has begun a new point: a stop that waited for the
+# points in progress would take about a point's time; it must take less than a quarter of it.
 args="sweep --figure 5 --parameter theta --range 0.8:2.6 --points 6 --mode continuation
-      --transient 40000 --periods 200 --threads 2 --quiet --no-plot"
+      --transient $transient --periods 200 --threads 2 --quiet --no-plot"
 total=12
 rm -rf "$out"
 mkdir -p "$out"
