@@ -17,43 +17,36 @@ function(run_pwl out)
   set(${out}_stderr "${stderr}" PARENT_SCOPE)
 endfunction()
 
-# 1. The title: single and double quotes, and a gnuplot expression that would run a command if the
-#    title were not passed as a string.
-run_pwl(titled ${PWL} ${case}
-        --title "it's \"quoted\" ' . system('touch ${WORK_DIR}/injected') . '"
-        --out ${WORK_DIR}/titled)
-if(NOT titled_code EQUAL 0)
-  message(FATAL_ERROR "titled run failed (${titled_code}): ${titled_stderr}")
-endif()
-foreach(f phase.png phase.svg poincare.csv)
-  if(NOT EXISTS ${WORK_DIR}/titled/${f})
-    message(FATAL_ERROR "titled run wrote no ${f}: ${titled_stdout} ${titled_stderr}")
+# 1. A title reaches the figure as text and runs nothing: the run `name` with --title `title`
+#    exits 0 and writes its figure and CSV, phase.svg holds `shown`, and the file `injected`,
+#    which the title would create if gnuplot ran a piece of it, does not exist.
+function(check_title name title shown injected)
+  run_pwl(run ${PWL} ${case} --title "${title}" --out ${WORK_DIR}/${name})
+  if(NOT run_code EQUAL 0)
+    message(FATAL_ERROR "${name}: run failed (${run_code}): ${run_stderr}")
   endif()
-endforeach()
-file(READ ${WORK_DIR}/titled/phase.svg svg)
-string(FIND "${svg}" "system(" at)
-if(at EQUAL -1)
-  message(FATAL_ERROR "the title's text is not in phase.svg")
-endif()
-if(EXISTS ${WORK_DIR}/injected)
-  message(FATAL_ERROR "the title was run as a gnuplot command")
-endif()
-# A line break in the title would end gnuplot's command there and run the next line: it becomes a
-# space, and the line after it stays text.
-run_pwl(broken_line ${PWL} ${case}
-        --title "first line\nsystem(\"touch ${WORK_DIR}/injected_by_newline\")\r\n"
-        --out ${WORK_DIR}/broken_line)
-if(NOT broken_line_code EQUAL 0 OR NOT EXISTS ${WORK_DIR}/broken_line/phase.svg)
-  message(FATAL_ERROR "title with a line break: exit ${broken_line_code}: ${broken_line_stderr}")
-endif()
-if(EXISTS ${WORK_DIR}/injected_by_newline)
-  message(FATAL_ERROR "the line after a line break in the title was run as a gnuplot command")
-endif()
-file(READ ${WORK_DIR}/broken_line/phase.svg svg)
-string(FIND "${svg}" "first line system(" at)
-if(at EQUAL -1)
-  message(FATAL_ERROR "the title's line break did not become a space in phase.svg")
-endif()
+  foreach(f phase.png phase.svg poincare.csv)
+    if(NOT EXISTS ${WORK_DIR}/${name}/${f})
+      message(FATAL_ERROR "${name}: no ${f}: ${run_stdout} ${run_stderr}")
+    endif()
+  endforeach()
+  file(READ ${WORK_DIR}/${name}/phase.svg svg)
+  string(FIND "${svg}" "${shown}" at)
+  if(at EQUAL -1)
+    message(FATAL_ERROR "${name}: \"${shown}\" is not in phase.svg")
+  endif()
+  if(EXISTS ${injected})
+    message(FATAL_ERROR "${name}: a piece of the title was run as a gnuplot command")
+  endif()
+endfunction()
+# Single and double quotes, and a gnuplot expression that would run a command if the title were
+# not passed as a string.
+check_title(titled "it's \"quoted\" ' . system('touch ${WORK_DIR}/injected') . '" "system("
+            ${WORK_DIR}/injected)
+# A line break would end gnuplot's command there and run the next line: it becomes a space, and
+# the line after it stays text.
+check_title(broken_line "first line\nsystem(\"touch ${WORK_DIR}/injected_by_newline\")\r\n"
+            "first line system(" ${WORK_DIR}/injected_by_newline)
 
 # 2. No gnuplot on PATH.
 file(MAKE_DIRECTORY ${WORK_DIR}/empty_bin)
