@@ -22,6 +22,7 @@
 #include "pwl/numerics/substructure_exponential.hpp"
 #include "pwl/numerics/state_checks.hpp"
 #include "numerics/row_blocks.hpp"
+#include "switching/local_switch_correction.hpp"
 #include "switching/switching_pim_detail.hpp"
 
 namespace pwl {
@@ -110,16 +111,19 @@ struct LoadTerm {
 };
 
 class BandedStepper final : public SwitchingPim,
-                            private switching_detail::ModeSeries<BandedStepper, Vector, Vector> {
+                            private switching_detail::ModeSeries<BandedStepper, Vector, Vector>,
+                            private switching_detail::LocalSwitchCorrection<BandedStepper> {
   friend switching_detail::ModeSeries<BandedStepper, Vector, Vector>;
+  friend switching_detail::LocalSwitchCorrection<BandedStepper>;
   using TangentOp = switching_detail::ModeSeries<BandedStepper, Vector, Vector>::TangentOp;
+  using RowSparseMatrix = RowSparse;
   static constexpr const char* kMethodName = "pim-switching-banded";
 
  public:
   BandedStepper(const GapStructure& s, const BandedSwitchingPimOptions& options)
       : o_(options.pim), n_(s.dofs()), m_(s.spring_count()), d_(options.pim.force_degree),
         eta_(options.pim.step), end_derivative_(options.pim.end_derivative),
-        solver_(options.lcp) {
+        correction_mode_(options.switch_correction), solver_(options.lcp) {
     // Sparse parts of the equation of motion, springs by position along the structure.
     const Vector inverse_mass = s.mass.diagonal().cwiseInverse();
     const std::vector<Index> order = springs_by_position(s);
@@ -148,6 +152,19 @@ class BandedStepper final : public SwitchingPim,
     gap_rows_ = RowSparse(SparseMatrix(W.transpose()));
     spring_rows_ = RowSparse(stiffnesses_.asDiagonal() * gap_rows_);
     spring_offset_ = stiffnesses_.cwiseProduct(gaps_);
+    // The reach of one Taylor term: the farthest two rows that K, C or a spring couple.
+    for (const RowSparse* part : {&stiffness_part_, &damping_part_, &gap_rows_}) {
+      for (Index i = 0; i < part->outerSize(); ++i) {
+        Index lo = i, hi = i;
+        for (RowSparse::InnerIterator it(*part, i); it; ++it) {
+          lo = std::min(lo, it.col());
+          hi = std::max(hi, it.col());
+        }
+        // gap rows: a spring's two ends; the others: a row and its columns.
+        reach_ = std::max(reach_, part == &gap_rows_ ? hi - lo : std::max(i - lo, hi - i));
+      }
+    }
+    reach_ = std::max<Index>(reach_, 1);
     abs_row_sums_.resize(m_);
     for (Index j = 0; j < m_; ++j) {
       double sum = 0.0;
@@ -210,6 +227,7 @@ class BandedStepper final : public SwitchingPim,
 
     const int terms = std::max(o_.max_series_terms, d_ + 2) + 1;
     size_series(static_cast<std::size_t>(terms), n_, m_);
+    size_local(m_);
     mode_ = Vector::Zero(m_);
     signs_ = Vector::Constant(m_, -1.0);
     state_ = Vector::Zero(2 * n_);
@@ -479,7 +497,7 @@ class BandedStepper final : public SwitchingPim,
     if (o_.locate_switches && screen_fails()) {
       ++diagnostics_.screened;
       lcp_synced_ = false;
-      switching_step(t, kMethodName);
+      switching(t);
       return;
     }
     transition_.multiply(state_.data(), bar_.data());
@@ -514,7 +532,7 @@ class BandedStepper final : public SwitchingPim,
         if ((z_[j] > 0.0) != (mode_[j] > 0.0)) {
           ++diagnostics_.lcp_mismatches;
           lcp_synced_ = false;
-      switching_step(t, kMethodName);
+          switching(t);
           return;
         }
       }
@@ -532,6 +550,35 @@ class BandedStepper final : public SwitchingPim,
       add_forces(slope_, slope_columns_, slope_guess_, state_);
     }
     finish_step();
+  }
+
+  // A switching step: corrected locally (see BandedSwitchingPimOptions::switch_correction) unless
+  // the step must be halved or, automatically, the correction spreads over too many rows. After
+  // such a step the next 1, 3, 7, ... 63 switching steps go to the whole state directly; a local
+  // step resets that.
+  void switching(double t) {
+    using Mode = BandedSwitchingPimOptions::SwitchCorrection;
+    if (correction_mode_ == Mode::whole_state) {
+      this->switching_step(t, kMethodName);
+      return;
+    }
+    const bool automatic = correction_mode_ == Mode::automatic;
+    if (automatic && local_skip_ > 0) {
+      --local_skip_;
+      this->switching_step(t, kMethodName);
+      return;
+    }
+    bool too_wide = false;
+    if (this->local_switching_step(t, kMethodName, automatic ? n_ / 4 : n_, &too_wide)) {
+      local_backoff_ = 1;
+      return;
+    }
+    if (too_wide) {
+      local_skip_ = local_backoff_;
+      local_backoff_ = std::min(2 * local_backoff_ + 1, 63);
+    }
+    // The series buffers hold the local attempt's longer series: start the pieces afresh.
+    this->switching_step(t, kMethodName, true);
   }
 
   void finish_step() {
@@ -554,6 +601,9 @@ class BandedStepper final : public SwitchingPim,
   int d_;
   double eta_;
   bool end_derivative_;
+  BandedSwitchingPimOptions::SwitchCorrection correction_mode_;
+  int local_skip_ = 0, local_backoff_ = 1;
+  Index reach_ = 0;
   BandedLcpSolver solver_;
   bool lcp_synced_ = false;
   BandTruncation truncation_;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <stdexcept>
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
@@ -422,6 +423,11 @@ class Stepper final
   void end_pieces() {
     upper(state_, n_) = xs_[0];
     lower(state_, n_) = us_[0];
+  }
+  // No local switch corrections in the dense stepper (a small system gains nothing by them).
+  void clear_local_records() {}
+  [[noreturn]] void replay_local_step(Index, Matrix&) {
+    throw std::logic_error("switching pim: a local step in the dense stepper's record");
   }
 
   // The series of the step from the current state: its start in xs_[0], us_[0].

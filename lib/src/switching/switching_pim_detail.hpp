@@ -160,6 +160,8 @@ inline ForceCoefficients force_coefficients(const std::vector<Matrix>& moments, 
 //   void set_mode(Index j, bool on);
 //   void end_pieces();                                     // the state from xs_[0], us_[0]
 //   void finish_step();
+//   void clear_local_records();                            // the record is dropped
+//   void replay_local_step(Index k, Matrix& tangent);      // a local_step op of the record
 //
 // and the data members mode_, signs_, gaps_, stiffnesses_, spring_offset_, loads_ (omega,
 // sin_part, cos_part: M⁻¹ times the load), m_, d_, eta_, o_ (SwitchingPimOptions), diagnostics_
@@ -214,10 +216,12 @@ class ModeSeries {
   // search for switches or the LCP. A few entries per step and switch; beyond kRecordLimit
   // entries the record is dropped (no replay) rather than grow without bound.
   struct TangentOp {
-    enum class Kind : unsigned char { mode_on, mode_off, step_start, smooth_step, piece };
+    // local_step: a switching step corrected locally (local_switch_correction.hpp), whose
+    // record the stepper keeps; `spring` is its index there.
+    enum class Kind : unsigned char { mode_on, mode_off, step_start, smooth_step, piece, local_step };
     Kind kind = Kind::step_start;
     int terms = 0;                // piece: R
-    Index spring = 0;             // mode_on, mode_off
+    Index spring = 0;             // mode_on, mode_off; local_step: the record's index
     double h = 0.0, sigma = 0.0;  // piece
   };
   static constexpr std::size_t kRecordLimit = std::size_t{1} << 22;  // 128 MiB of entries
@@ -240,6 +244,7 @@ class ModeSeries {
     record_open_ = false;
     record_complete_ = false;
     record_.clear();
+    self().clear_local_records();
   }
 
   // Appends to an open record while advance_with_tangent runs (not while replaying).
@@ -251,6 +256,10 @@ class ModeSeries {
       return;
     }
     record_.push_back(op);
+  }
+  // True while advance_with_tangent records (note() keeps what it is given).
+  bool noting() const {
+    return record_open_ && !replaying_ && tangent_ != nullptr && record_.size() < kRecordLimit;
   }
   void note_mode(Index j, bool on) {
     TangentOp op;
@@ -292,6 +301,9 @@ class ModeSeries {
         case TangentOp::Kind::piece:
           st.begin_piece();
           tangent_piece(op.h, op.terms, op.sigma);
+          break;
+        case TangentOp::Kind::local_step:
+          st.replay_local_step(op.spring, tangent);
           break;
       }
     }
@@ -415,42 +427,56 @@ class ModeSeries {
         poly_.c.col(r) = st.signs_.cwiseProduct(gw_[ru]);
       }
     }
-    start_ = event_detail::GapSample();
-    poly_.sample(start_, 0.0, start_);
+    return settle_kinks(poly_, nullptr, start_, settings_, flip_);
+  }
+
+  // The springs of `poly` (row i is spring springs[i], or spring i without a list) that sit on
+  // their kink at σ = 0: those whose motion certainly leaves the kink in the mode's direction get
+  // a certified_until time (and the kink tolerance where the departure is not yet certain), those
+  // whose motion points to the other side are listed in `flips` (global indices); true when there
+  // are such. Samples `poly` at 0 into `start` and resets `settings` for a search on [0, 1].
+  bool settle_kinks(PolynomialGaps& poly, const Index* springs, event_detail::GapSample& start,
+                    event_detail::SearchSettings& settings, std::vector<Index>& flips) {
+    const Stepper& st = self();
+    const Index count = poly.springs();
+    start = event_detail::GapSample();
+    poly.sample(start, 0.0, start);
     // The bounds of a polynomial are tight: try the whole piece at once and split only where
     // the envelopes cannot decide.
-    settings_.nominal_spacing = 1.0;
-    settings_.max_spacing = 0.0;
-    settings_.min_width = 64.0 * kEpsilon;
-    settings_.tolerance = Vector::Zero(st.m_);
-    settings_.certified_until = Vector::Constant(st.m_, -std::numeric_limits<double>::infinity());
-    flip_.clear();
-    for (Index j = 0; j < st.m_; ++j) {
+    settings.nominal_spacing = 1.0;
+    settings.max_spacing = 0.0;
+    settings.min_width = 64.0 * kEpsilon;
+    settings.tolerance = Vector::Zero(count);
+    settings.certified_until = Vector::Constant(count, -std::numeric_limits<double>::infinity());
+    flips.clear();
+    for (Index i = 0; i < count; ++i) {
+      const Index j = springs == nullptr ? i : springs[i];
       const double tol = st.kink_tolerance(j);
-      if (start_.e[j] > tol) continue;
+      if (start.e[i] > tol) continue;
       double until = 0.0;
       const int verdict =
-          locator_.certify_departure(poly_, start_, j, tol, 1.0, settings_.min_width, &until);
+          locator_.certify_departure(poly, start, i, tol, 1.0, settings.min_width, &until);
       if (verdict < 0) {
-        flip_.push_back(j);
+        flips.push_back(j);
       } else {
-        settings_.certified_until[j] = until;
-        if (verdict == 0) settings_.tolerance[j] = tol;
+        settings.certified_until[i] = until;
+        if (verdict == 0) settings.tolerance[i] = tol;
       }
     }
-    return !flip_.empty();
+    return !flips.empty();
   }
 
   // The step redone in pieces: each piece follows the Taylor series of the current mode up to
   // the first located switch, or to the end of the step. On entry xs_[0], us_[0] hold the step's
   // start and the series up to order d_ + 1 is in the buffers; the first piece continues that
-  // series instead of starting again. `method` names the stepper in errors.
-  void switching_step(double t0, const char* method) {
+  // series instead of starting again (with `fresh`, the buffers hold some other series of the
+  // start: it starts again). `method` names the stepper in errors.
+  void switching_step(double t0, const char* method, bool fresh = false) {
     Stepper& st = self();
     ++st.diagnostics_.switching_steps;
     double s = 0.0;
     int guard = 0;
-    int resume = st.d_;
+    int resume = fresh ? 0 : st.d_;
     while (s < st.eta_) {
       if (++guard > 10000) {
         throw DivergenceError(fmt::format(
@@ -518,35 +544,45 @@ class ModeSeries {
   // spring's force K2 (w^T x - Δ), zero at the located root up to its tolerance, so that term is
   // left out (no saltation for a continuous vector field).
   void tangent_piece(double h, int R, double sigma) {
-    Stepper& st = self();
     Matrix& Y = *tangent_;
     const Index n = xs_[0].size();
-    const int limit = std::max(R, st.o_.max_series_terms);
-    constexpr double tol = 0.5 * kEpsilon;
     for (Index c = 0; c < Y.cols(); ++c) {
       tx_ = Y.col(c).head(n);
       tu_ = Y.col(c).tail(n);
-      tsx_ = tx_;
-      tsu_ = tu_;
-      double largest = std::max(tx_.cwiseAbs().maxCoeff(), tu_.cwiseAbs().maxCoeff());
-      double previous = largest, power = 1.0;
-      for (int r = 0; r < limit; ++r) {
-        st.gap_product(tx_, tg_);
-        tp_ = st.mode_.cwiseProduct(st.stiffnesses_.cwiseProduct(tg_));
-        st.acceleration(tx_, tu_, tp_, tacc_);
-        const double f = h / (r + 1);
-        tx_ = f * tu_;
-        tu_ = f * tacc_;
-        power *= sigma;
-        tsx_ += power * tx_;
-        tsu_ += power * tu_;
-        const double size = std::max(tx_.cwiseAbs().maxCoeff(), tu_.cwiseAbs().maxCoeff());
-        largest = std::max(largest, size);
-        if (r + 1 >= R && r + 1 >= 4 && size + previous <= tol * largest) break;
-        previous = size;
-      }
+      tangent_series(h, R, sigma, [](int, const Half&) {});
       Y.col(c).head(n) = tsx_;
       Y.col(c).tail(n) = tsu_;
+    }
+  }
+
+  // The series of tangent_piece for one column, started from tx_, tu_ and summed at σ into tsx_,
+  // tsu_; on_term(r, x_r) sees the position part of every term, r = 0, 1, ... (the local switch
+  // corrections read the switching springs' gaps off them).
+  template <class OnTerm>
+  void tangent_series(double h, int R, double sigma, OnTerm&& on_term) {
+    Stepper& st = self();
+    const int limit = std::max(R, st.o_.max_series_terms);
+    constexpr double tol = 0.5 * kEpsilon;
+    tsx_ = tx_;
+    tsu_ = tu_;
+    on_term(0, tx_);
+    double largest = std::max(tx_.cwiseAbs().maxCoeff(), tu_.cwiseAbs().maxCoeff());
+    double previous = largest, power = 1.0;
+    for (int r = 0; r < limit; ++r) {
+      st.gap_product(tx_, tg_);
+      tp_ = st.mode_.cwiseProduct(st.stiffnesses_.cwiseProduct(tg_));
+      st.acceleration(tx_, tu_, tp_, tacc_);
+      const double f = h / (r + 1);
+      tx_ = f * tu_;
+      tu_ = f * tacc_;
+      on_term(r + 1, tx_);
+      power *= sigma;
+      tsx_ += power * tx_;
+      tsu_ += power * tu_;
+      const double size = std::max(tx_.cwiseAbs().maxCoeff(), tu_.cwiseAbs().maxCoeff());
+      largest = std::max(largest, size);
+      if (r + 1 >= R && r + 1 >= 4 && size + previous <= tol * largest) break;
+      previous = size;
     }
   }
 

@@ -27,12 +27,13 @@
 // term, and the C_r p_r are added from the columns of the touching springs only. A smooth step
 // therefore costs one banded product T v and d + 1 sparse recursion terms, plus O(contacts · q).
 //
-// Switching steps are redone in pieces exactly as in the dense stepper: in each piece the
-// motion is the Taylor series of the current mode about the piece's start, summed to rounding
-// with the sparse H (O(n) per term), the first spring switch is located on the gap polynomials
-// by the safeguarded root search of event_location.hpp, and the next piece starts there. Each
-// piece costs O(n · terms) on the whole state (not restricted to the band around the switching
-// spring).
+// Switching steps are redone exactly on the Taylor series of the motion, as in the dense stepper,
+// but corrected locally: the series of the start mode over the whole step on the whole state
+// (O(n) per term, sparse H), and from the first switch on the series of the correction the
+// switches make, on the rows it reaches (O(window) per term); switches are located on the gap
+// polynomials by the safeguarded root search of event_location.hpp
+// (local_switch_correction.hpp). Where springs switch all along the chain at once the stepper
+// redoes the step on the whole state instead, as the dense stepper does (switch_correction).
 //
 // The numbers are those of the dense make_switching_pim up to the band's truncation (the
 // tolerance of BandedExponentialOptions, 1e-15 of each operator block by default) and rounding.
@@ -77,6 +78,14 @@ struct BandedSwitchingPimOptions {
   SwitchingPimOptions pim;
   BandedExponentialOptions band;  // tolerance (or a forced band q), substructures, N
   BandedLcpOptions lcp;
+  // How switching steps are corrected (local_switch_correction.hpp). `local`: the series of the
+  // correction the switches make, on the rows it reaches; `whole_state`: every piece redone on
+  // the whole state, as the dense stepper does; `automatic`: local while the correction stays
+  // within a quarter of the rows, otherwise the step is redone on the whole state (springs
+  // switching all along the chain at once), and the next few switching steps go there directly.
+  // The three agree to rounding.
+  enum class SwitchCorrection { automatic, local, whole_state };
+  SwitchCorrection switch_correction = SwitchCorrection::automatic;
   // Ceres-style check: false with a message naming the field (pim.step, band.tolerance, ...)
   // and its value.
   bool is_valid(std::string* why) const;

@@ -134,6 +134,7 @@ struct SwitchingPimOptions {
 struct SwitchingPimDiagnostics {
   long steps = 0;
   long switching_steps = 0;  // steps redone in pieces
+  long local_steps = 0;      // of those, corrected locally (banded stepper)
   long pieces = 0;           // pieces of those steps
   long switches = 0;         // located spring switches
   long screened = 0;         // steps the gap screen sent to the series (a possible switch)
