@@ -4,10 +4,13 @@
 #include <fmt/ranges.h>
 
 #include <cmath>
+#include <algorithm>
 #include <filesystem>
+#include <limits>
 
 #include "commands/cli_checks.hpp"
 #include "commands/step_guard_report.hpp"
+#include "pwl/integrators/accuracy_step.hpp"
 #include "pwl/errors.hpp"
 #include "pwl/integrators/method_table.hpp"
 #include "scene/scene_structure.hpp"
@@ -135,10 +138,19 @@ void add_case_options(CLI::App& c, CaseOptions& o) {
   c.add_option("--periods", o.periods, "Forcing periods to integrate")->check(positive_number());
   c.add_option("--skip-periods", o.skip_periods, "Leading periods left out of the output")
       ->check(non_negative_number());
-  c.add_option("--steps-per-period", o.steps_per_period, "PIM steps per forcing period")
-      ->check(positive_number());
-  c.add_option("--dt", o.dt, "PIM step (must divide the forcing period; 0: --steps-per-period)")
-      ->check(non_negative_number());
+  CLI::Option* spp =
+      c.add_option("--steps-per-period", o.steps_per_period, "PIM steps per forcing period")
+          ->check(positive_number());
+  CLI::Option* dt =
+      c.add_option("--dt", o.dt, "PIM step (must divide the forcing period; 0: --steps-per-period)")
+          ->check(non_negative_number());
+  c.add_option("--rtol", o.rtol,
+               "PIM family: the largest step T/N whose estimated error, relative to the\n"
+               "motion, meets this over the first 4 periods (step doubling; instead of\n"
+               "--steps-per-period and --dt; at least 1e-12)")
+      ->check(positive_number())
+      ->excludes(spp)
+      ->excludes(dt);
   c.add_option("--method", o.method, method_help())->check(CLI::IsMember(method_names()));
   c.add_option("--tol", o.tolerance, "Relative and absolute tolerance of dopri5/rkf78")
       ->check(positive_number());
@@ -201,7 +213,40 @@ NondimensionalChain CaseOptions::chain() const {
   return c;
 }
 
+int CaseOptions::grid_steps(double period) const {
+  if (!(rtol > 0.0)) return steps_per_period;
+  if (rtol_steps > 0) return static_cast<int>(rtol_steps);
+  const Method m = parse_method(method);
+  if (!method_traits(m).fixed_grid) {
+    throw InputError(fmt::format("--rtol = {}: the accuracy request of the PIM family; {} takes "
+                                 "--tol",
+                                 rtol, method));
+  }
+  const GapStructure s = structure();
+  const Index n = s.dofs();
+  const Vector y = start.state(n);
+  MethodSettings settings;
+  settings.method = m;
+  settings.lcp = parse_lcp_algorithm(lcp_solver);
+  AccuracyRequest request;
+  request.relative_tolerance = rtol;
+  request.period = period;
+  request.probe = std::min(periods, 4) * period;
+  request.max_steps_per_period = std::numeric_limits<int>::max() / 2;
+  std::string why;
+  if (!request.is_valid(&why)) throw InputError("--rtol: " + why);
+  const AccuracyStep chosen = step_for_accuracy(s, settings, 0.0, y.head(n), y.tail(n), request);
+  rtol_steps = chosen.steps_per_period;
+  fmt::print(stderr,
+             "pwl: note: --rtol {:g}: η = T/{} = {:.6g} (estimated error {:.2g} over the first {} "
+             "periods; {} steps tried)\n",
+             rtol, chosen.steps_per_period, chosen.step, chosen.estimated_error,
+             std::min(periods, 4), chosen.candidates);
+  return static_cast<int>(rtol_steps);
+}
+
 double CaseOptions::step(double period) const {
+  if (rtol > 0.0) return period / grid_steps(period);
   if (dt == 0.0) return period / steps_per_period;
   if (!(dt > 0.0)) throw InputError(fmt::format("--dt = {} must be positive", dt));
   const double ratio = period / dt;
@@ -229,7 +274,7 @@ analysis::PointModel CaseOptions::model() const {
 MethodSettings CaseOptions::method_settings(double period) const {
   MethodSettings m;
   m.method = parse_method(method);
-  if (method_traits(m.method).fixed_grid) m.step = step(period);
+  if (method_traits(m.method).fixed_grid || rtol > 0.0) m.step = step(period);  // --rtol: checks the method
   m.tolerance = tolerance;
   m.locate_kinks = locate_kinks;
   m.max_step = period / 8;

@@ -66,6 +66,9 @@ struct CaseOptions {
   int skip_periods = 0;  // periods left out of the written output
   int steps_per_period = 200;
   double dt = 0.0;             // overrides steps_per_period; must divide the period
+  // > 0: the PIM family's accuracy request (accuracy_step.hpp), instead of steps_per_period and
+  // dt: the largest step T/N whose estimated error over the first periods meets it.
+  double rtol = 0.0;
   std::string method = "pim";  // a name of the method table (method_names())
   double tolerance = 1e-10;
   bool locate_kinks = false;
@@ -75,6 +78,7 @@ struct CaseOptions {
   std::string structure_scene;
   InitialStateFlags start;  // --x0, --v0
   bool force = false;       // --force: run a step the step guard refuses
+  mutable long rtol_steps = 0;  // what --rtol chose (0: not yet)
 
   // The chain these flags describe (the preset, then each given flag).
   NondimensionalChain chain() const;
@@ -89,8 +93,12 @@ struct CaseOptions {
   double period() const;
   // A short description for titles and messages.
   std::string description() const;
-  // The step the PIM uses: period / steps_per_period, or dt when it divides the period.
+  // The step the PIM uses: period / steps_per_period, or dt when it divides the period, or the
+  // step --rtol asks for (found once, on the first periods of this case from its start, and
+  // noted on stderr).
   double step(double period) const;
+  // Steps per forcing period: steps_per_period, or the number --rtol chose.
+  int grid_steps(double period) const;
   // The method table's settings these flags give (the step only for fixed-grid methods; for the
   // exact solver, its progress on stderr during a long advance: step_guard_report.hpp).
   MethodSettings method_settings(double period) const;

@@ -102,7 +102,7 @@ SimulationSummary simulate_case(const SimulateOptions& options, SimulationSink& 
   const double period = run.period();
   std::unique_ptr<Integrator> integrator = run.integrator(structure, period);
   analysis::SectionSampler sampler(*integrator, structure, period, section,
-                                   run.method_settings(period), run.steps_per_period);
+                                   run.method_settings(period), run.grid_steps(period));
   sink.started(*integrator, structure);
 
   std::vector<double> row(1 + 2 * output.record.size());

@@ -1,0 +1,148 @@
+// The step for a requested accuracy (accuracy_step.hpp): step doubling on a probe stretch.
+#include "pwl/integrators/accuracy_step.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "pwl/errors.hpp"
+#include "pwl/integrators/step_guard.hpp"
+
+namespace pwl {
+
+bool AccuracyRequest::is_valid(std::string* why) const {
+  std::string scratch;
+  if (why == nullptr) why = &scratch;
+  const auto bad = [why](const std::string& message) {
+    *why = message;
+    return false;
+  };
+  if (!(relative_tolerance > 0.0) || !std::isfinite(relative_tolerance) || relative_tolerance >= 1.0) {
+    return bad(fmt::format("relative_tolerance = {} must be in (0, 1)", relative_tolerance));
+  }
+  if (relative_tolerance < kSmallestRelativeTolerance) {
+    return bad(fmt::format("relative_tolerance = {} is below {}: the rounding of a run of many "
+                           "steps in double precision",
+                           relative_tolerance, kSmallestRelativeTolerance));
+  }
+  if (!(period > 0.0) || !std::isfinite(period)) {
+    return bad(fmt::format("period = {} must be positive and finite", period));
+  }
+  if (!(probe > 0.0) || !std::isfinite(probe)) {
+    return bad(fmt::format("probe = {} must be positive and finite", probe));
+  }
+  if (max_steps_per_period < 1) {
+    return bad(fmt::format("max_steps_per_period = {} must be at least 1", max_steps_per_period));
+  }
+  return true;
+}
+
+namespace {
+
+// The states [x; x'] at every `stride`-th multiple of η over the probe.
+std::vector<Vector> probe_states(const GapStructure& structure, MethodSettings settings,
+                                 double step, double t0, const Vector& x0, const Vector& v0,
+                                 long points, long stride) {
+  settings.step = step;
+  std::unique_ptr<Integrator> integrator = make_integrator(structure, settings);
+  integrator->set_state(t0, x0, v0);
+  std::vector<Vector> states;
+  states.reserve(static_cast<std::size_t>(points));
+  const Index n = structure.dofs();
+  for (long k = 1; k <= points; ++k) {
+    integrator->advance_to(t0 + static_cast<double>(k * stride) * step);
+    Vector y(2 * n);
+    y << integrator->position(), integrator->velocity();
+    states.push_back(std::move(y));
+  }
+  return states;
+}
+
+// The relative difference of two sets of probe states: the largest position difference over the
+// largest position, the same for the velocities, the larger of the two.
+double relative_difference(const std::vector<Vector>& a, const std::vector<Vector>& b, Index n) {
+  double dx = 0.0, dv = 0.0, sx = 0.0, sv = 0.0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    dx = std::max(dx, (a[k].head(n) - b[k].head(n)).cwiseAbs().maxCoeff());
+    dv = std::max(dv, (a[k].tail(n) - b[k].tail(n)).cwiseAbs().maxCoeff());
+    sx = std::max(sx, b[k].head(n).cwiseAbs().maxCoeff());
+    sv = std::max(sv, b[k].tail(n).cwiseAbs().maxCoeff());
+  }
+  const double ex = sx > 0.0 ? dx / sx : dx;
+  const double ev = sv > 0.0 ? dv / sv : dv;
+  return std::max(ex, ev);
+}
+
+}  // namespace
+
+AccuracyStep step_for_accuracy(const GapStructure& structure, const MethodSettings& base,
+                               double t0, const Vector& x0, const Vector& v0,
+                               const AccuracyRequest& request) {
+  std::string why;
+  if (!request.is_valid(&why)) throw InputError("accuracy request: " + why);
+  const MethodTraits& traits = method_traits(base.method);
+  if (!traits.fixed_grid) {
+    throw InputError(fmt::format(
+        "a relative tolerance chooses the step of a fixed-step method (the PIM family); {} "
+        "chooses its own steps: give it its tolerance instead",
+        traits.name));
+  }
+  const bool switching = base.method == Method::pim_switching ||
+                         base.method == Method::pim_switching_dense ||
+                         base.method == Method::pim_switching_banded;
+  const int order = switching ? base.force_degree + 3 : std::max(1, traits.order);
+  const double omega = contact_frequency(structure).omega_max;
+  const double period = request.period;
+  AccuracyStep out;
+  out.largest_step = traits.step_warning > 0.0 && omega > 0.0 ? traits.step_warning / omega : period;
+  long steps = std::max<long>(1, static_cast<long>(std::ceil(period / out.largest_step - 1e-9)));
+  const Index n = structure.dofs();
+  double best = -1.0;
+  long best_steps = 0;
+  while (true) {
+    if (steps > request.max_steps_per_period) {
+      throw InputError(fmt::format(
+          "relative tolerance = {:.3g}: {} does not reach it on this structure within {} steps "
+          "per period (the best estimate, at T/{}, is {:.3g})",
+          request.relative_tolerance, traits.name, request.max_steps_per_period, best_steps,
+          best));
+    }
+    const double step = period / static_cast<double>(steps);
+    // Compare at about 50 grid points of the probe (multiples of η, on both grids).
+    const long total = std::max<long>(1, static_cast<long>(std::ceil(request.probe / step - 1e-9)));
+    const long stride = std::max<long>(1, total / 50);
+    const long points = std::max<long>(1, total / stride);
+    const std::vector<Vector> coarse = probe_states(structure, base, step, t0, x0, v0, points, stride);
+    const std::vector<Vector> fine =
+        probe_states(structure, base, step / 2, t0, x0, v0, points, 2 * stride);
+    ++out.candidates;
+    const double difference = relative_difference(coarse, fine, n);
+    const double estimate = 2.0 * difference;
+    if (best < 0.0 || estimate < best) {
+      best = estimate;
+      best_steps = steps;
+    }
+    if (estimate <= request.relative_tolerance) {
+      out.steps_per_period = steps;
+      out.step = step;
+      out.estimated_error = estimate;
+      return out;
+    }
+    // At rounding the halving no longer changes the motion: smaller steps cannot help.
+    if (difference < 1e-13) {
+      throw InputError(fmt::format(
+          "relative tolerance = {:.3g}: below what {} reaches on this structure (the estimate "
+          "stays at {:.3g}, rounding)",
+          request.relative_tolerance, traits.name, estimate));
+    }
+    // The step the estimate asks for, and at least a tenth shorter (an estimate outside its
+    // asymptotic range can promise too much).
+    const double factor = std::pow(0.8 * request.relative_tolerance / estimate, 1.0 / order);
+    const auto next = static_cast<long>(std::ceil(static_cast<double>(steps) / std::min(0.9, factor)));
+    steps = std::max(next, steps + 1);
+  }
+}
+
+}  // namespace pwl
