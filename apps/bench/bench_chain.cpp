@@ -14,6 +14,7 @@
 
 #include "output/csv_writer.hpp"
 #include "pwl/errors.hpp"
+#include "pwl/integrators/accuracy_step.hpp"
 #include "pwl/integrators/banded_step_rule.hpp"
 #include "pwl/integrators/method_table.hpp"
 #include "pwl/model/chain_builders.hpp"
@@ -43,6 +44,7 @@ struct BenchRow {
   MethodSettings settings;
   bool base = false;
   std::optional<BandedStepRuleOptions> rule;
+  std::optional<AccuracyRequest> accuracy;  // the step from an accuracy request
 };
 
 // The settings of an adaptive row at tolerance `tol`, kink-located or plain.
@@ -93,8 +95,8 @@ const ChainMethodResult* fastest_pwl_row_as_accurate_as(const ChainBenchResult& 
 }  // namespace
 
 std::vector<std::string> chain_bench_methods() {
-  return {"pim-banded",   "pim-rule",          "pim-switching",     "pim-dense",
-          "dopri5-1e-5",  "dopri5-1e-10",      "dopri5-1e-5-kinks", "dopri5-1e-10-kinks"};
+  return {"pim-banded",  "pim-rule",     "pim-switching",     "pim-rtol",          "pim-dense",
+          "dopri5-1e-5", "dopri5-1e-10", "dopri5-1e-5-kinks", "dopri5-1e-10-kinks"};
 }
 
 ChainBenchResult run_chain_bench(const ChainBenchOptions& o) {
@@ -163,7 +165,8 @@ ChainBenchResult run_chain_bench(const ChainBenchOptions& o) {
   if (wanted("pim-banded")) {
     methods.push_back({"pim-banded", "banded PIM (paper step)",
                        fmt::format("η = {:g} s, band from tol 1e-15", o.paper_step), o.runs,
-                       fixed_step(Method::pim_banded, o.paper_step), true, std::nullopt});
+                       fixed_step(Method::pim_banded, o.paper_step), true, std::nullopt,
+                       std::nullopt});
   }
   if (wanted("pim-rule")) {
     for (int q : o.rule_bands) {
@@ -177,20 +180,37 @@ ChainBenchResult run_chain_bench(const ChainBenchOptions& o) {
       methods.push_back(
           {"pim-rule", fmt::format("banded PIM (rule, q = {})", q),
            fmt::format("η1 = {:g} s -> η = {:g} s, q = {}", o.wished_step, choice.step, q),
-           o.runs, settings, false, rule});
+           o.runs, settings, false, rule, std::nullopt});
     }
   }
   if (wanted("pim-switching")) {
     for (double step : o.switching_steps) {
       methods.push_back({"pim-switching", "banded switching PIM",
                          fmt::format("η = {:g} s, order 5, switches located", step), o.runs,
-                         fixed_step(Method::pim_switching_banded, step), false, std::nullopt});
+                         fixed_step(Method::pim_switching_banded, step), false, std::nullopt,
+                         std::nullopt});
+    }
+  }
+  const Vector rest = Vector::Zero(o.masses);
+  if (wanted("pim-rtol")) {
+    for (double rtol : o.accuracy_requests) {
+      AccuracyRequest request;
+      request.relative_tolerance = rtol;
+      request.period = o.t_end;  // the step divides the run (its end is on the grid)
+      request.probe = std::min(o.t_end, 4 * M_PI);  // two periods of the loads (sin 3t, sin 5t)
+      MethodSettings settings = fixed_step(Method::pim_switching_banded, 0.0);
+      // The step it finds, for the label; the timed runs find it again.
+      const AccuracyStep chosen = step_for_accuracy(structure, settings, 0.0, rest, rest, request);
+      methods.push_back({"pim-rtol", "banded switching PIM (--rtol)",
+                         fmt::format("rtol = {:g} -> η = {:.4g} s (estimate {:.1e} on [0, {:.3g}] s)",
+                                     rtol, chosen.step, chosen.estimated_error, request.probe),
+                         o.runs, settings, false, std::nullopt, request});
     }
   }
   if (wanted("pim-dense")) {
     methods.push_back({"pim-dense", "dense PIM", fmt::format("η = {:g} s", o.paper_step),
                        o.dense_runs, fixed_step(Method::pim_dense, o.paper_step), false,
-                       std::nullopt});
+                       std::nullopt, std::nullopt});
   }
   for (auto [key, tol, kinks] :
        std::vector<std::tuple<std::string, double, bool>>{{"dopri5-1e-5", 1e-5, false},
@@ -200,17 +220,19 @@ ChainBenchResult run_chain_bench(const ChainBenchOptions& o) {
     if (!wanted(key)) continue;
     methods.push_back({key, kinks ? "dopri5, kink-located" : "dopri5 (plain, like ode45)",
                        fmt::format("rtol = atol = {:g}", tol), o.runs,
-                       runge_kutta(Method::dopri5, tol, kinks), false, std::nullopt});
+                       runge_kutta(Method::dopri5, tol, kinks), false, std::nullopt, std::nullopt});
   }
-  // The set-up timed for a row: the step rule (when the row takes its step from it) and the
-  // integrator's operators.
-  const auto build = [&structure](const BenchRow& m) {
+  // The set-up timed for a row: the step rule or the accuracy request's probe runs (when the row
+  // takes its step from them) and the integrator's operators.
+  const auto build = [&structure, &rest](const BenchRow& m) {
     MethodSettings settings = m.settings;
     if (m.rule) settings.step = select_banded_step(structure, *m.rule).step;
+    if (m.accuracy) {
+      settings.step = step_for_accuracy(structure, settings, 0.0, rest, rest, *m.accuracy).step;
+    }
     return make_integrator(structure, settings);
   };
 
-  const Vector rest = Vector::Zero(o.masses);
   for (const BenchRow& m : methods) {
     say(fmt::format("{} ({}): {} run{} ...", m.label, m.parameters, m.runs, m.runs > 1 ? "s" : ""));
     ChainMethodResult r;

@@ -25,6 +25,10 @@ struct ChainBenchOptions {
   std::vector<int> rule_bands{5, 8};  // q given to the step rule (the paper: 5, its 11-dof piece)
   // Steps of the banded switching PIM (order 5, switches located), one row each.
   std::vector<double> switching_steps{0.1, 0.04, 0.02};
+  // Accuracy requests for the banded switching PIM (accuracy_step.hpp), one row each: the step
+  // (dividing t_end) found on the first two periods of the loads (4π s) and the run at it, both
+  // timed.
+  std::vector<double> accuracy_requests{1e-6, 1e-9};
   bool without_dense = false;         // leave the dense PIM out (minutes per run at n = 1000)
   double reference_tolerance = 1e-12;
   double reference_grid = 0.005;      // s, spacing of the reference's recorded points

@@ -14,6 +14,7 @@
 #include <memory>
 
 #include "commands/cli_checks.hpp"
+#include "pwl/integrators/accuracy_step.hpp"
 #include "bench/accuracy_bench.hpp"
 #include "bench/bench_chain.hpp"
 #include "bench/bench_orbits.hpp"
@@ -58,8 +59,14 @@ void add_chain(CLI::App& bench) {
                 "Steps of the banded switching PIM rows (s), comma separated")
       ->delimiter(',')
       ->check(positive_number());
+  c->add_option("--rtol-rows", o->accuracy_requests,
+                "Accuracy requests (--rtol) of the banded switching PIM rows, comma separated:\n"
+                "the step chosen on the loads' first two periods, choice and run timed together")
+      ->delimiter(',')
+      ->check(positive_number())
+      ->check(number_in(kSmallestRelativeTolerance, 0.5));
   c->add_option("--methods", o->methods,
-                "Only these methods: pim-banded, pim-rule, pim-switching, pim-dense, dopri5-1e-5, "
+                "Only these methods: pim-banded, pim-rule, pim-switching, pim-rtol, pim-dense, dopri5-1e-5, "
                 "dopri5-1e-10, dopri5-1e-5-kinks, dopri5-1e-10-kinks")
       ->delimiter(',');
   c->add_flag("--without-dense", o->without_dense,

@@ -4,15 +4,17 @@
 # η = 0.02 s are within reach of the kink-located rkf78 reference at 1e-12 (the finer below 1e-10
 # in x1 and x1') and their errors fall like η^5 or faster (the method's order with force degree 2
 # is 5: measured order >= 4.5); and for each dopri5 row the table names the fastest pwl row at or
-# below both its errors. No timing is asserted.
+# below both its errors. The rows of the accuracy requests 1e-6 and 1e-9 (--rtol-rows: the step
+# found on the run's first 5 s) are within them in x1 and x1' (the motion's size is about 1).
+# No timing is asserted.
 # Usage: bench_chain_switching.sh PWL OUTPUT_FOLDER
 set -u
 pwl=$1
 out=$2
 rm -rf "$out"
 mkdir -p "$(dirname "$out")"
-"$pwl" bench chain --n 100 --t-end 5 --runs 1 --methods pim-switching,pim-dense,dopri5-1e-10 \
-       --without-dense --switching-steps 0.1,0.02 --out "$out" --quiet > "$out.txt" 2>&1 ||
+"$pwl" bench chain --n 100 --t-end 5 --runs 1 --methods pim-switching,pim-rtol,pim-dense,dopri5-1e-10 \
+       --without-dense --switching-steps 0.1,0.02 --rtol-rows 1e-6,1e-9 --out "$out" --quiet > "$out.txt" 2>&1 ||
   { cat "$out.txt"; echo "pwl bench chain failed"; exit 1; }
 cat "$out.txt"
 if grep -q '| dense PIM |' "$out/bench_chain.md"; then
@@ -23,6 +25,8 @@ awk -F'|' '
   $2 ~ /banded switching PIM/ && $3 ~ /η = 0.1 s/ { coarse_x = $9 + 0; coarse_v = $10 + 0; n++ }
   $2 ~ /banded switching PIM/ && $3 ~ /η = 0.02 s/ { fine_x = $9 + 0; fine_v = $10 + 0; n++ }
   $0 ~ /^- dopri5 \(plain, like ode45\) \(rtol = atol = 1e-10\): banded switching PIM/ { named = 1 }
+  $2 ~ /--rtol/ && $3 ~ /rtol = 1e-06/ { r6 = ($9 + 0 <= 1e-6 && $10 + 0 <= 1e-6); m++ }
+  $2 ~ /--rtol/ && $3 ~ /rtol = 1e-09/ { r9 = ($9 + 0 <= 1e-9 && $10 + 0 <= 1e-9); m++ }
   END {
     if (n != 2) { print "expected two switching rows, found " n; exit 1 }
     order_x = log(coarse_x / fine_x) / log(5); order_v = log(coarse_v / fine_v) / log(5)
@@ -30,5 +34,7 @@ awk -F'|' '
     if (!(fine_x < 1e-10 && fine_v < 1e-10)) { print "the fine row is not below 1e-10"; exit 1 }
     if (!(order_x >= 4.5 && order_v >= 4.5)) { print "the measured order is below 4.5"; exit 1 }
     if (!named) { print "no pwl row named against dopri5 at 1e-10"; exit 1 }
+    if (m != 2) { print "expected two rows of accuracy requests, found " m; exit 1 }
+    if (!(r6 && r9)) { print "an accuracy request row misses its tolerance"; exit 1 }
     print "switching rows: accurate, order 5, named against dopri5"
   }' "$out/bench_chain.md"

@@ -149,6 +149,7 @@ void add_case_options(CLI::App& c, CaseOptions& o) {
                "motion, meets this over the first 4 periods (step doubling; instead of\n"
                "--steps-per-period and --dt; at least 1e-12)")
       ->check(positive_number())
+      ->check(number_in(kSmallestRelativeTolerance, 0.5))
       ->excludes(spp)
       ->excludes(dt);
   c.add_option("--method", o.method, method_help())->check(CLI::IsMember(method_names()));
