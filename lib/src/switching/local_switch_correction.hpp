@@ -28,11 +28,12 @@
 // (which every switching step pays to find its first switch) and, per piece, O(terms · window)
 // instead of O(terms · n).
 //
-// The tangent map follows the same split with the same pieces and windows: the whole-step series
-// of y_u's tangent in m0, and the windowed series of δ's, whose source is c ∘ K2 W^T of y_u's
-// tangent (no saltation term: the vector field is continuous). The record of a locally corrected
-// step (its pieces, their lengths, terms and windows, the springs each toggles) is kept for
-// replay, so a replayed tangent is bit for bit the one advance_with_tangent gives.
+// The tangent map follows the same split with the same pieces: the whole-step series of y_u's
+// tangent in m0, and the windowed series of δ's, whose source is c ∘ K2 W^T of y_u's tangent (no
+// saltation term: the vector field is continuous), its rows trimmed by its own size (its source,
+// unlike the state's, is not zero at the switch). The record of a locally corrected step (its
+// pieces, their lengths and terms, the springs that switch) is kept for replay, so a replayed
+// tangent is bit for bit the one advance_with_tangent gives.
 //
 // The global path (ModeSeries::switching_step) stays the fallback: when y_u's series does not
 // converge over the whole step within max_series_terms (it then halves pieces), and when the
@@ -126,13 +127,12 @@ template <class Stepper>
 class LocalSwitchCorrection {
  protected:
   // One piece of a locally corrected step: from σ0 (a fraction of the step) for ρ of it, the
-  // series of δ with `terms` terms, ending at τ (a fraction of the piece); the rows δ starts on,
-  // and the springs that switch at its end.
+  // series of δ with `terms` terms, ending at τ (a fraction of the piece), and the springs that
+  // switch around it.
   struct LocalPiece {
     double sigma0 = 0.0, rho = 0.0, tau = 0.0;
     int terms = 0;
-    RowRanges rows;
-    std::vector<Index> flips;    // springs settled on their kink at its start (before `rows`)
+    std::vector<Index> flips;    // springs settled on their kink at its start
     std::vector<Index> toggles;  // springs that switch at its end
   };
   struct LocalStep {
@@ -140,8 +140,14 @@ class LocalSwitchCorrection {
     int terms = 0;     // of y_u's series
     std::vector<LocalPiece> pieces;
     std::vector<Index> first_toggles;  // the springs that switch at the first crossing
-    RowRanges end_rows;                // where δ(η) is kept
     std::vector<Index> sources;        // every spring whose mode differs from m0 in some piece
+    // Memory held, for the record's bound.
+    std::size_t bytes() const {
+      std::size_t b = sizeof(LocalStep) + static_cast<std::size_t>(base_mode.size()) * sizeof(double) +
+                      (first_toggles.size() + sources.size()) * sizeof(Index);
+      for (const LocalPiece& p : pieces) b += sizeof(LocalPiece) + (p.flips.size() + p.toggles.size()) * sizeof(Index);
+      return b;
+    }
   };
 
   Stepper& me() { return static_cast<Stepper&>(*this); }
@@ -153,7 +159,10 @@ class LocalSwitchCorrection {
     base_mode_ = Vector::Zero(m);
   }
 
-  void clear_local_records() { local_records_.clear(); }
+  void clear_local_records() {
+    local_records_.clear();
+    local_record_bytes_ = 0;
+  }
 
   // The tangent of the recorded step `index` applied to `tangent` (replay).
   void replay_local_step(Index index, Matrix& tangent) {
@@ -184,6 +193,7 @@ class LocalSwitchCorrection {
     }
     local_switches_ = 0;
     local_pieces_ = 0;
+    local_rows_ = 0;
     terms_u_ = R;
     base_mode_ = st.mode_;
     scale_ = 0.0;
@@ -211,6 +221,23 @@ class LocalSwitchCorrection {
       found_.assign(first.springs.begin(), first.springs.end());
     }
     ensure_terms(max_terms);
+    // A throw from here on (a step the springs chatter through, a series that does not converge)
+    // must not leave δ's rows or the mask behind for the next step after set_state.
+    try {
+      return local_pieces(t0, method, max_rows, too_wide, std::move(record), keep);
+    } catch (...) {
+      discard_local();
+      throw;
+    }
+  }
+
+ private:
+  // The pieces of local_switching_step from its first switch (found_, at sigma_).
+  bool local_pieces(double t0, const char* method, Index max_rows, bool* too_wide,
+                    LocalStep&& moved_record, bool keep) {
+    Stepper& st = me();
+    const int max_terms = st.o_.max_series_terms;
+    LocalStep record = std::move(moved_record);
     changed_.clear();
     mask_.clear();
     support_.clear();
@@ -245,10 +272,12 @@ class LocalSwitchCorrection {
         clear_terms(terms);
         rho *= 0.5;
         whole = false;
+        ++st.diagnostics_.halved_pieces;
         if (!(rho > 0.0)) throw DivergenceError(fmt::format("{}: the Taylor series did not converge", method));
         build_sources(sigma_, rho, true);
       }
       ++local_pieces_;
+      local_rows_ += rows_[static_cast<std::size_t>(terms)].rows();
       if (rows_[static_cast<std::size_t>(terms)].rows() > max_rows) {
         clear_terms(terms);
         abandon();
@@ -289,14 +318,15 @@ class LocalSwitchCorrection {
       found_.clear();
       for (Index k : inside.springs) found_.push_back(mask_[static_cast<std::size_t>(k)]);
       outside_search();
-      // The piece ends at the first switch, inside the window or outside it (a tie goes to the
-      // outside spring; the inside one is then found at the start of the next piece).
+      // The piece ends at the first switch, inside the window or outside it (both at a tie).
       const double tau_outside = out_found_ ? (out_sigma_ - sigma_) / rho : 2.0;
       double tau = 1.0, next = whole ? 1.0 : sigma_ + rho;
       if (out_found_ && tau_outside <= 1.0 && tau_outside <= tau_inside) {
         tau = tau_outside;
         next = std::min(1.0, out_sigma_);
-        found_ = out_springs_;
+        const bool tie = inside_found && tau_inside == tau_outside;
+        if (!tie) found_.clear();
+        found_.insert(found_.end(), out_springs_.begin(), out_springs_.end());
         out_valid_ = false;
       } else if (inside_found) {
         tau = tau_inside;
@@ -310,7 +340,6 @@ class LocalSwitchCorrection {
         piece.rho = rho;
         piece.tau = tau;
         piece.terms = terms;
-        piece.rows = support_;
         piece.flips = pending_flips_;
         piece.toggles = found_;
         record.pieces.push_back(std::move(piece));
@@ -334,7 +363,20 @@ class LocalSwitchCorrection {
     return true;
   }
 
- private:
+  // Everything a local step leaves in the buffers, dropped (after a throw).
+  void discard_local() {
+    clear_terms(live_terms_);
+    support_.for_each_row([&](Index i) {
+      dx_[0][i] = 0.0;
+      du_[0][i] = 0.0;
+    });
+    support_.clear();
+    for (Index j : mask_) in_mask_[static_cast<std::size_t>(j)] = 0;
+    mask_.clear();
+    changed_.clear();
+    reset_source_rows();
+  }
+
   // The step's end y_u(η) + δ(η), its tangent, and the stepper's end of step.
   void finish_local(LocalStep&& record, bool keep) {
     Stepper& st = me();
@@ -351,15 +393,23 @@ class LocalSwitchCorrection {
     ++st.diagnostics_.switching_steps;
     ++st.diagnostics_.local_steps;
     st.diagnostics_.pieces += 1 + local_pieces_;
+    st.diagnostics_.local_rows += local_rows_;
     if (keep) {
-      record.end_rows = support_;
       local_tangent(record, *st.tangent_);
       if (st.noting()) {
-        typename Stepper::TangentOp op;
-        op.kind = Stepper::TangentOp::Kind::local_step;
-        op.spring = static_cast<Index>(local_records_.size());
-        local_records_.push_back(std::move(record));
-        st.note(op);
+        // Kept within the same bound as the record's entries (ModeSeries::kRecordLimit of them):
+        // beyond it the record is dropped (no replay) rather than grow without bound.
+        const std::size_t bytes = record.bytes();
+        if (local_record_bytes_ + bytes > Stepper::kRecordLimit * sizeof(typename Stepper::TangentOp)) {
+          st.end_record();
+        } else {
+          typename Stepper::TangentOp op;
+          op.kind = Stepper::TangentOp::Kind::local_step;
+          op.spring = static_cast<Index>(local_records_.size());
+          local_records_.push_back(std::move(record));
+          local_record_bytes_ += bytes;
+          st.note(op);
+        }
       }
     }
     support_.clear();
@@ -510,6 +560,7 @@ class LocalSwitchCorrection {
         size = std::max({size, std::abs(x1[i]), std::abs(u1[i])});
       });
       largest = std::max(largest, size);
+      live_terms_ = r + 1;
       if (r + 1 >= min_terms && r + 1 >= 4 && size + previous <= 0.5 * kEpsilon * largest) {
         return r + 1;
       }
@@ -520,6 +571,7 @@ class LocalSwitchCorrection {
 
   // Zero the terms 1..terms of δ (their rows).
   void clear_terms(int terms) {
+    live_terms_ = 0;
     for (int r = 1; r <= terms; ++r) {
       const auto ru = static_cast<std::size_t>(r);
       rows_[ru].for_each_row([&](Index i) {
@@ -671,40 +723,29 @@ class LocalSwitchCorrection {
       // δ's tangent through the pieces, from zero, after the first crossing's switches.
       changed_.clear();
       support_.clear();
-      for (Index j : record.first_toggles) {
-        st.mode_[j] = st.mode_[j] > 0.0 ? 0.0 : 1.0;
-        note_change(j);
-      }
-      for (std::size_t p = 0; p < record.pieces.size(); ++p) {
-        const LocalPiece& piece = record.pieces[p];
-        for (Index j : piece.flips) {
+      const auto toggle_all = [&](const std::vector<Index>& springs) {
+        for (Index j : springs) {
           st.mode_[j] = st.mode_[j] > 0.0 ? 0.0 : 1.0;
           note_change(j);
         }
-        support_ = piece.rows;
+        add_changed_rows(support_);
+      };
+      toggle_all(record.first_toggles);
+      // Each piece as the state's, its rows trimmed by this column's own size (its source, unlike
+      // the state's, is not zero at the switch).
+      for (const LocalPiece& piece : record.pieces) {
+        toggle_all(piece.flips);
         build_sources(piece.sigma0, piece.rho, false);
         const int terms = delta_series(piece.rho * st.eta_, st.mode_, piece.terms,
                                        st.o_.max_series_terms, scale);
-        evaluate_delta(piece.tau, terms);
-        const RowRanges& next = p + 1 < record.pieces.size() ? record.pieces[p + 1].rows : record.end_rows;
-        rows_[static_cast<std::size_t>(terms)].for_each_row([&](Index i) {
-          scratch_x_[i] = 0.0;
-          scratch_u_[i] = 0.0;
-          if (!contains(next, i)) {
-            dx_[0][i] = 0.0;
-            du_[0][i] = 0.0;
-          }
-        });
-        for (Index j : piece.toggles) {
-          st.mode_[j] = st.mode_[j] > 0.0 ? 0.0 : 1.0;
-          note_change(j);
-        }
+        end_piece(piece.tau, terms, scale);
+        toggle_all(piece.toggles);
       }
       for (Index i = 0; i < n; ++i) {
         Y(i, c) = st.tsx_[i];
         Y(n + i, c) = st.tsu_[i];
       }
-      record.end_rows.for_each_row([&](Index i) {
+      support_.for_each_row([&](Index i) {
         Y(i, c) += dx_[0][i];
         Y(n + i, c) += du_[0][i];
         dx_[0][i] = 0.0;
@@ -727,8 +768,8 @@ class LocalSwitchCorrection {
   RowRanges support_;
   Vector scratch_x_, scratch_u_;
   Vector base_mode_;
-  int terms_u_ = 0;
-  long local_switches_ = 0, local_pieces_ = 0;
+  int terms_u_ = 0, live_terms_ = 0;  // live: terms 1..live of δ may be non-zero
+  long local_switches_ = 0, local_pieces_ = 0, local_rows_ = 0;
   double sigma_ = 0.0, scale_ = 0.0;
   std::vector<Index> changed_, mask_, found_, flips_, pending_flips_;
   std::vector<int> source_row_;  // row of sources_ for a changed spring, -1 otherwise
@@ -747,6 +788,7 @@ class LocalSwitchCorrection {
   int tangent_terms_ = 0;
   const std::vector<Index>* tangent_sources_ = nullptr;
   std::vector<LocalStep> local_records_;
+  std::size_t local_record_bytes_ = 0;
 };
 
 }  // namespace pwl::switching_detail

@@ -494,6 +494,7 @@ class ModeSeries {
         if (R < st.o_.max_series_terms) break;
         h *= 0.5;
         whole = false;
+        ++st.diagnostics_.halved_pieces;
         if (!(h > 0.0)) {
           throw DivergenceError(fmt::format("{}: the Taylor series did not converge", method));
         }

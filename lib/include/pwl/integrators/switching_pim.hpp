@@ -135,6 +135,8 @@ struct SwitchingPimDiagnostics {
   long steps = 0;
   long switching_steps = 0;  // steps redone in pieces
   long local_steps = 0;      // of those, corrected locally (banded stepper)
+  long local_rows = 0;       // rows of their corrections' series, summed over their pieces
+  long halved_pieces = 0;    // pieces of switching steps halved for their series to converge
   long pieces = 0;           // pieces of those steps
   long switches = 0;         // located spring switches
   long screened = 0;         // steps the gap screen sent to the series (a possible switch)
