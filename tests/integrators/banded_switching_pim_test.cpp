@@ -192,6 +192,22 @@ GapStructure switching_chain(int masses) {
   return make_chain(p);
 }
 
+// Advances a and b together to t0 + k spacing, k = 1..count; the largest difference of their
+// states [x; x'] at those times, and the largest entry of b's.
+struct SideBySide {
+  double difference = 0.0, largest = 0.0;
+};
+SideBySide side_by_side(Integrator& a, Integrator& b, double t0, double spacing, int count) {
+  SideBySide r;
+  for (int k = 1; k <= count; ++k) {
+    a.advance_to(t0 + k * spacing);
+    b.advance_to(t0 + k * spacing);
+    r.difference = std::max(r.difference, (state_of(a) - state_of(b)).cwiseAbs().maxCoeff());
+    r.largest = std::max(r.largest, state_of(b).cwiseAbs().maxCoeff());
+  }
+  return r;
+}
+
 // A state in motion, its springs switching: the dense switching PIM's state at t from rest.
 Vector moving_state(const GapStructure& s, double eta, double t) {
   SwitchingPimOptions o;
@@ -397,14 +413,7 @@ TEST_CASE("banded switching PIM: local and global switch corrections agree",
     auto b = make_banded_switching_pim(s, global);
     a->set_state(4.0, y0.head(n), y0.tail(n));
     b->set_state(4.0, y0.head(n), y0.tail(n));
-    double worst = 0.0, largest = 0.0;
-    for (int k = 1; k <= 100; ++k) {
-      const double t = 4.0 + 10 * k * c.eta;
-      a->advance_to(t);
-      b->advance_to(t);
-      worst = std::max(worst, (state_of(*a) - state_of(*b)).cwiseAbs().maxCoeff());
-      largest = std::max(largest, state_of(*b).cwiseAbs().maxCoeff());
-    }
+    const auto [worst, largest] = side_by_side(*a, *b, 4.0, 10 * c.eta, 100);
     const SwitchingPimDiagnostics da = a->diagnostics(), db = b->diagnostics();
     INFO("switches " << da.switches << " / " << db.switches << ", switching steps "
                      << da.switching_steps << " (" << da.local_steps << " local) / "
@@ -480,13 +489,7 @@ TEST_CASE("banded switching PIM: automatic corrections fall back to the whole st
   const Vector zero = Vector::Zero(n);
   a->set_state(0.0, zero, zero);
   b->set_state(0.0, zero, zero);
-  double worst = 0.0, largest = 0.0;
-  for (int k = 1; k <= 60; ++k) {
-    a->advance_to(k * 10 * eta);
-    b->advance_to(k * 10 * eta);
-    worst = std::max(worst, (state_of(*a) - state_of(*b)).cwiseAbs().maxCoeff());
-    largest = std::max(largest, state_of(*b).cwiseAbs().maxCoeff());
-  }
+  const auto [worst, largest] = side_by_side(*a, *b, 0.0, 10 * eta, 60);
   const SwitchingPimDiagnostics da = a->diagnostics(), db = b->diagnostics();
   // Locality: where springs switch one at a time the corrections' series run on a small part of
   // the chain (rows of their last terms, averaged over the pieces after each step's first switch).
@@ -567,13 +570,7 @@ TEST_CASE("banded switching PIM: local corrections with stiff contacts halve the
   const Vector zero = Vector::Zero(n);
   a->set_state(0.0, zero, zero);
   b->set_state(0.0, zero, zero);
-  double worst = 0.0, largest = 0.0;
-  for (int k = 1; k <= 40; ++k) {
-    a->advance_to(k * 0.5);
-    b->advance_to(k * 0.5);
-    worst = std::max(worst, (state_of(*a) - state_of(*b)).cwiseAbs().maxCoeff());
-    largest = std::max(largest, state_of(*b).cwiseAbs().maxCoeff());
-  }
+  const auto [worst, largest] = side_by_side(*a, *b, 0.0, 0.5, 40);
   const SwitchingPimDiagnostics da = a->diagnostics(), db = b->diagnostics();
   INFO("switches " << da.switches << " / " << db.switches << ", switching steps "
                    << da.switching_steps << " (" << da.local_steps << " local), pieces "
