@@ -431,18 +431,10 @@ class LocalSwitchCorrection {
   // the mode changes and their reversal, which cancel).
   void abandon() {
     Stepper& st = me();
-    support_.for_each_row([&](Index i) {
-      dx_[0][i] = 0.0;
-      du_[0][i] = 0.0;
-    });
-    support_.clear();
     for (Index j : changed_) st.set_mode(j, base_mode_[j] > 0.0);
-    changed_.clear();
     st.diagnostics_.switches -= local_switches_;
     st.stats_.kink_events -= local_switches_;
-    for (Index j : mask_) in_mask_[static_cast<std::size_t>(j)] = 0;
-    mask_.clear();
-    reset_source_rows();
+    discard_local();
   }
   // A mode settled on its kink (not counted).
   void set_local_mode(Index j) {
