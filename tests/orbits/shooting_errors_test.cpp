@@ -90,6 +90,11 @@ TEST_CASE("shooting options and inputs that cannot work are refused naming the f
   o.max_iterations = 0;
   CHECK(contains(refused(exact, o, y), "max iterations = 0"));
   o = {};
+  o.max_forcing = 1.0;
+  CHECK(contains(refused(exact, o, y), "max forcing = 1"));
+  o.max_forcing = std::nan("");
+  CHECK(contains(refused(exact, o, y), "max forcing = nan"));
+  o = {};
   o.solver = ShootingSolver::krylov;
   o.shots = 2;
   CHECK(contains(refused(exact, o, y), "shots = 2"));

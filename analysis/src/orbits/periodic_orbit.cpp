@@ -29,6 +29,12 @@ bool ShootingOptions::is_valid(std::string* why) const {
     *why = fmt::format("max iterations = {} must be >= 1", max_iterations);
     return false;
   }
+  if (!(max_forcing > 0 && max_forcing < 1)) {
+    *why = fmt::format("max forcing = {} must lie in (0, 1) (GMRES's relative residual per Newton "
+                       "step at most)",
+                       max_forcing);
+    return false;
+  }
   if (gmres_dimension < 1 || gmres_restarts < 0) {
     *why = fmt::format("gmres dimension = {} must be >= 1 and restarts = {} >= 0",
                        gmres_dimension, gmres_restarts);
@@ -275,12 +281,15 @@ PeriodicOrbit find_periodic_orbit(StroboscopicMap& map, const Vector& guess,
       map.advance(y, options.period, t);
       return t.col(0) - pv;
     };
-    // Eisenstat-Walker forcing (their choice 2, with its safeguard), never below what the
-    // tolerance needs.
+    // Eisenstat-Walker forcing, their choice 2 (γ = 0.9, α = 2) with its safeguard (η_k is kept
+    // at γ η_{k−1}^2 or above while that exceeds 0.1) and its ceiling η_max (options.max_forcing),
+    // never below what the tolerance needs. The ceiling matters: while Newton converges only
+    // linearly (iterates far out, where the contacts make the map's derivative change along the
+    // step), solving for the step accurately buys nothing and each product costs the most.
     if (iteration > 0) {
       double next = 0.9 * std::pow(residual / previous_residual, 2);
-      if (0.9 * forcing * forcing > 1e-2) next = std::max(next, 0.9 * forcing * forcing);
-      forcing = std::min(next, 1e-2);
+      if (0.9 * forcing * forcing > 0.1) next = std::max(next, 0.9 * forcing * forcing);
+      forcing = std::min(next, options.max_forcing);
     }
     forcing = std::max(forcing, 0.5 * options.tolerance * std::max(1.0, inf_norm(y)) / residual);
     Vector u;
