@@ -23,7 +23,7 @@
 // records its tangent map (the banded switching PIM) only the first integrates, the others replay
 // it (stroboscopic_map.hpp). A product then costs the tangent's arithmetic, which grows with the
 // pieces the springs' switches cut the steps into: on the 1000-mass chain of `pwl bench orbits`
-// Newton's early iterates move whole stretches of the chain across the gaps (about 2000 switches
+// Newton's early iterates move whole stretches of the chain across the gaps (about 1000 switches
 // a period, 60-100 ms a replayed product) while the orbit itself switches 14 times a period
 // (about 6 ms).
 //
