@@ -358,6 +358,22 @@ TEST_CASE("weighted Birkhoff: periodic orbits and fixed points", "[weighted_birk
   CHECK(periodic.digits >= 13.0);
   CHECK(periodic.smooth_invariant_curve);
   CHECK(std::abs(periodic.rotation_number - 0.4) < 1e-13);
+  // A period-2 record as an integration gives it (the 5-DOF chain's at α = 3, θ = 1 alternates
+  // between two points, each repeated to about 1e-13): u is 0 or 1 up to about 1e-12 on every
+  // coordinate, so sin(π u) varies by rounding only. Measured against its own spread its halves
+  // would disagree in the first digit; against its natural size 1 they agree to rounding.
+  Matrix two(600, 3);
+  for (Index i = 0; i < two.rows(); ++i) {
+    const double jitter = 1e-13 * std::sin(1.7 * static_cast<double>(i));
+    if (i % 2 == 0) {
+      two.row(i) << -0.00847362 + jitter, -0.42518106 - jitter, 1.3 + jitter;
+    } else {
+      two.row(i) << -0.85799977 - jitter, -1.15825157 + jitter, 0.7 - jitter;
+    }
+  }
+  const WeightedBirkhoffResult alternating = weighted_birkhoff_test(two);
+  CHECK(alternating.digits >= 11.0);
+  CHECK(alternating.smooth_invariant_curve);  // as any periodic record (see the header)
   // A fixed point: nothing varies, nothing is measured, and it is not called a curve.
   const Matrix still = Matrix::Constant(300, 4, 0.25);
   WeightedBirkhoffOptions no_rotation;

@@ -188,10 +188,16 @@ WeightedBirkhoffResult weighted_birkhoff_test(const Matrix& points,
   result.centre.resize(dim);
 
   // One observable's series: averages, digits, and whether it counts.
-  auto record = [&](std::vector<double>& values) {
+  // `scale`: the observable's natural size. The coordinates and the caller's observables have
+  // only their own spread; cos(π u) and sin(π u) have 1, and their half difference is measured
+  // against it: on a record of a few distinct points (a periodic orbit: u = 0 or 1 up to the
+  // rounding of the integration, about 1e-12 after division by the range) sin(π u) varies by
+  // rounding only, and relative to that spread its halves would disagree in the first digit.
+  auto record = [&](std::vector<double>& values, double scale) {
     const SeriesStatistics s = statistics(values, weights);
-    const bool varies = s.spread > options.constant_tolerance * s.largest_magnitude;
-    const double relative = varies ? s.half_difference / s.spread : 0.0;
+    const bool varies =
+        s.spread > options.constant_tolerance * std::max(s.largest_magnitude, scale);
+    const double relative = varies ? s.half_difference / std::max(s.spread, scale) : 0.0;
     result.averages.push_back(s.average);
     result.relative_differences.push_back(relative);
     result.observable_digits.push_back(digits_of(relative));
@@ -207,14 +213,14 @@ WeightedBirkhoffResult weighted_birkhoff_test(const Matrix& points,
       const auto [lowest, highest] = std::minmax_element(values.begin(), values.end());
       const double low = *lowest;
       const double range = *highest - low;
-      result.centre[j] = record(values);
+      result.centre[j] = record(values, 0.0);
       for (int which = 0; which < 2; ++which) {
         for (std::size_t i = 0; i < count; ++i) {
           const double x = points(static_cast<Index>(i), j);
           const double u = range > 0.0 ? (x - low) / range : 0.0;
           values[i] = which == 0 ? std::cos(std::numbers::pi * u) : std::sin(std::numbers::pi * u);
         }
-        record(values);
+        record(values, 1.0);
       }
     }
   } else {
@@ -236,7 +242,7 @@ WeightedBirkhoffResult weighted_birkhoff_test(const Matrix& points,
                           k, values[i], i));
         }
       }
-      record(values);
+      record(values, 0.0);
     }
   }
 
