@@ -23,6 +23,7 @@
 #include "output/csv_writer.hpp"
 #include "output/gnuplot.hpp"
 #include "pwl/errors.hpp"
+#include "pwl/orbits/orbit_refinement.hpp"
 
 namespace pwl::app {
 namespace {
@@ -205,6 +206,24 @@ void analyze(const AnalyzeOptions& o) {
                : std::string(result.regime == "unbounded"
                                  ? "the motion left the divergence bound before the record ended"
                                  : "a contact problem (LCP) had no solution"));
+  // Orbit refinement (orbit_refinement.hpp) when the record is called quasi-periodic or uncertain,
+  // which a slow approach to a periodic orbit can look like: the periodic orbit the motion is on
+  // or approaching, if Newton finds one from the motion's last state (at phase 0: a whole number
+  // of periods after the record), with the rate of the approach. Evidence printed beside the
+  // regime, which it does not change yet.
+  if (c && (result.regime == "uncertain" || result.regime == "quasi-periodic") &&
+      s.section.stroboscopic() &&
+      result.final_state.size() == 2 * n) {
+    std::vector<Vector> points;
+    for (std::size_t i = 0; (i + 1) * static_cast<std::size_t>(2 * n) <= a.section_states.size();
+         ++i) {
+      points.push_back(Eigen::Map<const Vector>(a.section_states.data() + i * 2 * n, 2 * n));
+    }
+    orbits::StroboscopicMap map(analysis::PointCase(o.run.structure(), period), s.method,
+                                s.steps_per_period);
+    const orbits::OrbitRefinement refined = orbits::refine_orbit(map, points, result.final_state);
+    fmt::print("  orbit refinement: {}\n", refined.describe());
+  }
   if (std::FILE* f = std::fopen((o.out + "/classification.csv").c_str(), "w")) {
     fmt::print(f, "regime,period,lambda1_per_period,lambda1_error,K\n{},{},{:.10g},{:.3g},{:.6g}\n",
                result.regime, c ? c->period : 0, result.lambda1, result.lambda1_error, result.K);

@@ -1,0 +1,176 @@
+// Orbit refinement against independent truth: a lightly damped linear oscillator (its orbit the
+// harmonic response, its multipliers exp(λ T) in closed form, its approach counted period by
+// period); a gap oscillator whose slow spiral onto a period-1 orbit is integrated out by the exact
+// solver (the orbit and the count of periods it takes); candidate periods of a period-3 record;
+// an unstable orbit inside figure 6's chaos, which does not describe the motion.
+#include <Eigen/Eigenvalues>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "orbit_cases.hpp"
+#include "pwl/model/chain_builders.hpp"
+#include "pwl/orbits/orbit_refinement.hpp"
+#include "test_structures.hpp"
+
+using namespace pwl;
+using namespace pwl::orbits;
+
+namespace {
+
+double inf_norm(const Vector& v) { return v.lpNorm<Eigen::Infinity>(); }
+
+// Forcing periods from y until |y − orbit|_∞ <= tolerance, at most `limit`.
+long periods_until(StroboscopicMap& map, Vector y, const Vector& orbit, double tolerance,
+                   long limit) {
+  for (long k = 0; k < limit; ++k) {
+    if (inf_norm(y - orbit) <= tolerance) return k;
+    y = map.advance(y, 1);
+  }
+  return limit;
+}
+
+}  // namespace
+
+TEST_CASE("orbit refinement settles a lightly damped linear oscillator's slow approach",
+          "[orbits][refinement]") {
+  // m x'' + c x' + k x = q sin(ω t), c small: |μ| = exp(−c T / 2m) ≈ 0.996 a period.
+  GapStructure s = pwl::test::single_mass(1.0, 0.003, 1.0);
+  s.loads.push_back({0, 0.4, 1.3, 0.0});
+  const double omega = 1.3, T = 2 * M_PI / omega;
+  StroboscopicMap map(analysis::PointCase(s, T), MethodSettings{Method::exact}, 1);
+  const std::vector<Vector> points =
+      pwl::test::poincare_points(map, Vector::Zero(2), 100, 300);  // from rest
+  const Vector last = points.back();
+
+  const OrbitRefinement r = refine_orbit(map, points, last);
+  INFO(r.describe());
+  REQUIRE(r.found);
+  CHECK(r.orbit.period == 1);
+  const Vector expected = pwl::test::harmonic_response(s, omega);
+  CHECK(inf_norm(r.orbit.state - expected) <= 1e-12);
+  const double rate = std::exp(-0.003 / 2 * T);  // the closed-form |μ| per period
+  CHECK(r.contraction_per_period == Approx(rate).epsilon(1e-10));
+  CHECK(r.attracting);
+  CHECK_FALSE(r.on_orbit);
+  CHECK(r.explains_motion());
+  CHECK(r.distance == Approx(inf_norm(last - expected)).epsilon(1e-9));
+  // The estimate against the count, period by period, to the same tolerance.
+  const long counted = periods_until(map, last, expected, r.tolerance, 100000);
+  pwl::test::measured("linear oscillator: periods to settle estimated", r.periods_to_settle);
+  pwl::test::measured("linear oscillator: periods to settle counted", static_cast<double>(counted));
+  CHECK(counted > 2000);  // a long transient indeed
+  CHECK(std::abs(r.periods_to_settle - counted) <= 0.05 * counted);
+  CHECK(r.describe().find("attracting") != std::string::npos);
+}
+
+TEST_CASE("orbit refinement settles a gap oscillator's slow spiral onto its period-1 orbit",
+          "[orbits][refinement]") {
+  pwl::test::GapOscillator g;
+  g.zeta = 0.0005;
+  g.q = 0.3;
+  g.theta = 0.8;
+  StroboscopicMap map(g.point_case(), MethodSettings{Method::exact}, 1);
+  const std::vector<Vector> points = pwl::test::poincare_points(map, Vector::Zero(2), 200, 300);
+  const Vector last = points.back();
+
+  const OrbitRefinement r = refine_orbit(map, points, last);
+  INFO(r.describe());
+  REQUIRE(r.found);
+  REQUIRE(r.orbit.period == 1);
+  REQUIRE(r.attracting);
+  CHECK_FALSE(r.on_orbit);
+  // The truth: the same exact solver, integrated until the motion stops moving.
+  Vector y = last;
+  long settled = -1;
+  for (long k = 1; k <= 60000; ++k) {
+    const Vector next = map.advance(y, 1);
+    if (inf_norm(next - y) <= 1e-13) {
+      settled = k;
+      y = next;
+      break;
+    }
+    y = next;
+  }
+  REQUIRE(settled > 0);
+  pwl::test::measured("gap oscillator: orbit against the motion integrated out",
+                      inf_norm(r.orbit.state - y));
+  CHECK(inf_norm(r.orbit.state - y) <= 1e-10);
+  // The motion came within the tolerance after about the periods the multiplier predicts.
+  const long counted = periods_until(map, last, r.orbit.state, r.tolerance, 100000);
+  pwl::test::measured("gap oscillator: periods to settle estimated", r.periods_to_settle);
+  pwl::test::measured("gap oscillator: periods to settle counted", static_cast<double>(counted));
+  CHECK(counted > 1000);
+  CHECK(std::abs(r.periods_to_settle - counted) <= 0.15 * counted);
+}
+
+TEST_CASE("candidate periods of a period-3 record are 3, not its multiples",
+          "[orbits][refinement]") {
+  std::vector<Vector> points;
+  const Vector a = Vector::Constant(2, 1.0), b = Vector::Constant(2, -0.5),
+               c = Vector::Constant(2, 0.25);
+  for (int i = 0; i < 200; ++i) {
+    const Vector& p = i % 3 == 0 ? a : i % 3 == 1 ? b : c;
+    points.push_back(p + Vector::Constant(2, 1e-6 * std::sin(0.37 * i)));  // a little wobble
+  }
+  const std::vector<int> k = candidate_periods(points, 100, 3);
+  REQUIRE_FALSE(k.empty());
+  CHECK(k.front() == 3);
+  for (int p : k) CHECK((p == 3 || p % 3 != 0));
+}
+
+TEST_CASE("an unstable orbit inside chaos is found but does not describe the motion",
+          "[orbits][refinement]") {
+  StroboscopicMap map(analysis::PointCase(paper_five_dof_case("6")), MethodSettings{Method::exact},
+                      1);
+  const std::vector<Vector> points = pwl::test::poincare_points(map, Vector::Zero(10), 300, 300);
+  // Newton from the recorded point that moves least in one period (the period-1 orbit of
+  // chaotic_saddle_orbit_test.cpp), the candidates limited to period 1.
+  std::size_t best = 0;
+  for (std::size_t i = 0; i + 1 < points.size(); ++i) {
+    if (inf_norm(points[i + 1] - points[i]) < inf_norm(points[best + 1] - points[best])) best = i;
+  }
+  RefinementOptions o;
+  o.max_period = 1;
+  const OrbitRefinement r = refine_orbit(map, points, points[best], o);
+  INFO(r.describe());
+  REQUIRE(r.found);
+  CHECK(r.orbit.period == 1);
+  CHECK(r.orbit.multipliers.largest_modulus() > 1.0);
+  CHECK_FALSE(r.attracting);
+  CHECK_FALSE(r.on_orbit);
+  CHECK(r.distance > 1e-3);
+  CHECK_FALSE(r.explains_motion());
+  CHECK(r.describe().find("does not describe the motion") != std::string::npos);
+}
+
+TEST_CASE("orbit refinement refuses bad options and states naming the field",
+          "[orbits][refinement][errors]") {
+  pwl::test::GapOscillator g;
+  StroboscopicMap map(g.point_case(), MethodSettings{Method::exact}, 1);
+  const std::vector<Vector> points(10, Vector::Zero(2));
+  const auto message = [&](const RefinementOptions& o, const Vector& y) {
+    try {
+      refine_orbit(map, points, y, o);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  RefinementOptions o;
+  o.max_period = 0;
+  CHECK(message(o, Vector::Zero(2)).find("max period = 0") != std::string::npos);
+  o = {};
+  o.candidates = 0;
+  CHECK(message(o, Vector::Zero(2)).find("candidates = 0") != std::string::npos);
+  o = {};
+  o.on_orbit_tolerance = -1;
+  CHECK(message(o, Vector::Zero(2)).find("on-orbit tolerance = -1") != std::string::npos);
+  o = {};
+  o.shooting.tolerance = 0;
+  CHECK(message(o, Vector::Zero(2)).find("tolerance = 0") != std::string::npos);
+  o = {};
+  CHECK(message(o, Vector::Zero(3)).find("last state has 3 components") != std::string::npos);
+  CHECK(message(o, Vector::Constant(2, std::nan(""))).find("not finite") != std::string::npos);
+}
