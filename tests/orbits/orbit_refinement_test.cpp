@@ -54,6 +54,12 @@ TEST_CASE("orbit refinement settles a lightly damped linear oscillator's slow ap
   CHECK(r.contraction_per_period == Approx(rate).epsilon(1e-10));
   CHECK(r.attracting);
   CHECK_FALSE(r.on_orbit);
+  // Step 4: carried on until the multiplier predicts half the distance, the motion shrank its
+  // distance about as predicted (a linear map: the slowest mode's factor, up to the rotation of
+  // the error in the phase plane).
+  CHECK(r.approach_confirmed);
+  CHECK(r.predicted_factor == Approx(0.5).epsilon(0.01));
+  CHECK(r.measured_factor == Approx(0.5).epsilon(0.1));
   CHECK(r.explains_motion());
   CHECK(r.distance == Approx(inf_norm(last - expected)).epsilon(1e-9));
   // The estimate against the count, period by period, to the same tolerance.
@@ -81,6 +87,12 @@ TEST_CASE("orbit refinement settles a gap oscillator's slow spiral onto its peri
   REQUIRE(r.orbit.period == 1);
   REQUIRE(r.attracting);
   CHECK_FALSE(r.on_orbit);
+  CHECK(r.approach_confirmed);
+  pwl::test::measured("gap oscillator: distance factor measured", r.measured_factor);
+  // Of the predicted order (measured 0.38 against 0.50: the contacts' pieces still add to the
+  // slowest mode's decay half a distance out).
+  CHECK(r.measured_factor <= std::sqrt(r.predicted_factor));
+  CHECK(r.measured_factor >= r.predicted_factor * r.predicted_factor);
   // The truth: the same exact solver, integrated until the motion stops moving.
   Vector y = last;
   long settled = -1;
@@ -103,6 +115,57 @@ TEST_CASE("orbit refinement settles a gap oscillator's slow spiral onto its peri
   pwl::test::measured("gap oscillator: periods to settle counted", static_cast<double>(counted));
   CHECK(counted > 1000);
   CHECK(std::abs(r.periods_to_settle - counted) <= 0.15 * counted);
+}
+
+TEST_CASE("an attracting orbit the motion does not approach is not taken for the motion's",
+          "[orbits][refinement]") {
+  // One mass of the nondimensional chain, ζ = 0.001, α = 0.5, Δ̃ = 0.5, Q = 0.5, θ = 0.8: from
+  // rest the motion ends on a period-3 orbit (the truth below: the exact solver, 6000 periods
+  // on), while a stable period-1 orbit coexists with it. After 300 periods Newton from the last
+  // state at period 1 (the only candidate allowed here) converges to the period-1 orbit,
+  // attracting; the motion is not approaching it.
+  NondimensionalChain c;
+  c.masses = 1;
+  c.alpha = {0.5};
+  c.zeta = 0.001;
+  c.gap = {0.5};
+  c.amplitude = {0.5};
+  c.theta = 0.8;
+  StroboscopicMap map(analysis::PointCase(c), MethodSettings{Method::exact}, 1);
+  const std::vector<Vector> early = pwl::test::poincare_points(map, Vector::Zero(2), 300, 300);
+  RefinementOptions only_one;
+  only_one.max_period = 1;
+  const OrbitRefinement r = refine_orbit(map, early, early.back(), only_one);
+  INFO(r.describe());
+  REQUIRE(r.found);
+  REQUIRE(r.orbit.period == 1);
+  CHECK(r.attracting);
+  CHECK_FALSE(r.on_orbit);
+  CHECK_FALSE(r.approach_confirmed);
+  CHECK_FALSE(r.explains_motion());
+  CHECK(r.describe().find("does not approach it as predicted") != std::string::npos);
+
+  // The truth: 6000 periods on, the motion repeats every 3 periods, not every period, and
+  // stays far from the period-1 orbit.
+  const Vector settled = map.advance(early.back(), 6000);
+  CHECK(inf_norm(map.advance(settled, 3) - settled) <= 1e-8);
+  CHECK(inf_norm(map.advance(settled, 1) - settled) > 1e-2);
+  CHECK(inf_norm(settled - r.orbit.state) > 0.1);
+
+  // With the candidates from the record's near returns (period 3 among them), the period-1
+  // orbit is passed over and the period-3 orbit found, approached as predicted.
+  const OrbitRefinement late = refine_orbit(map, early, early.back());
+  INFO(late.describe());
+  REQUIRE(late.found);
+  CHECK(late.orbit.period == 3);
+  CHECK(late.explains_motion());
+  double nearest = inf_norm(settled - late.orbit.state);
+  Vector y = late.orbit.state;
+  for (int j = 1; j < 3; ++j) {
+    y = map.advance(y, 1);
+    nearest = std::min(nearest, inf_norm(settled - y));
+  }
+  CHECK(nearest <= 1e-8);
 }
 
 TEST_CASE("candidate periods of a period-3 record are 3, not its multiples",
@@ -164,6 +227,9 @@ TEST_CASE("orbit refinement refuses bad options and states naming the field",
   o = {};
   o.candidates = 0;
   CHECK(message(o, Vector::Zero(2)).find("candidates = 0") != std::string::npos);
+  o = {};
+  o.max_check_periods = 0;
+  CHECK(message(o, Vector::Zero(2)).find("max check periods = 0") != std::string::npos);
   o = {};
   o.on_orbit_tolerance = -1;
   CHECK(message(o, Vector::Zero(2)).find("on-orbit tolerance = -1") != std::string::npos);

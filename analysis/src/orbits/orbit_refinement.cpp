@@ -24,6 +24,10 @@ bool RefinementOptions::is_valid(std::string* why) const {
     *why = fmt::format("candidates = {} must be >= 1", candidates);
     return false;
   }
+  if (max_check_periods < 1) {
+    *why = fmt::format("max check periods = {} must be >= 1", max_check_periods);
+    return false;
+  }
   if (!(on_orbit_tolerance > 0) || !std::isfinite(on_orbit_tolerance)) {
     *why = fmt::format("on-orbit tolerance = {} must be positive and finite", on_orbit_tolerance);
     return false;
@@ -81,22 +85,62 @@ std::vector<int> candidate_periods(const std::vector<Vector>& points, int max_pe
         break;
       }
     }
+    // A multiple of a period chosen already (with a closer return) adds nothing: Newton for it
+    // finds the same orbits, reduced to their least period. A divisor is kept: its Newton is
+    // cheaper and converges from farther out, and a period-j orbit that does not describe the
+    // motion does not stop the search (refine_orbit goes on to the next candidate).
     const bool multiple =
         std::any_of(chosen.begin(), chosen.end(), [d](int c) { return d % c == 0; });
     if (!multiple) chosen.push_back(d);
   }
-  // Shortest first, and no multiple of a shorter candidate (one chosen before its divisor).
-  std::sort(chosen.begin(), chosen.end());
-  chosen.erase(std::remove_if(chosen.begin(), chosen.end(),
-                              [&](int k) {
-                                return std::any_of(chosen.begin(), chosen.end(), [k](int c) {
-                                  return c < k && k % c == 0;
-                                });
-                              }),
-               chosen.end());
+  std::sort(chosen.begin(), chosen.end());  // shortest first: the cheapest Newton
   if (chosen.empty()) chosen.push_back(1);
   return chosen;
 }
+
+namespace {
+
+// Steps 3 and 4 for the orbit in r: where the motion is with respect to it.
+void assess(StroboscopicMap& map, const Vector& last_state, const RefinementOptions& options,
+            OrbitRefinement& r) {
+  // The distance from the motion to the nearest of the orbit's k points at phase 0.
+  const int k = r.orbit.period;
+  const auto nearest_point = [&](const Vector& state) {
+    Vector y = r.orbit.state;
+    double nearest = inf_norm(state - y);
+    for (int j = 1; j < k; ++j) {
+      y = map.advance(y, 1);
+      nearest = std::min(nearest, inf_norm(state - y));
+    }
+    return nearest;
+  };
+  r.tolerance = options.on_orbit_tolerance * std::max(1.0, inf_norm(r.orbit.state));
+  r.distance = nearest_point(last_state);
+  r.on_orbit = r.distance <= r.tolerance;
+  const FloquetMultipliers& mu = r.orbit.multipliers;
+  r.attracting = mu.converged && mu.stable();
+  const double rho = mu.largest_modulus();
+  r.contraction_per_period = rho > 0 ? std::pow(rho, 1.0 / k) : 0.0;
+  r.periods_to_settle = 0;
+  r.check_periods = 0;
+  r.measured_factor = r.predicted_factor = 0;
+  r.approach_confirmed = false;
+  if (!r.attracting || r.on_orbit) return;
+  r.periods_to_settle = rho > 0 ? k * std::log(r.tolerance / r.distance) / std::log(rho) : k;
+  // Step 4: carry the motion on and compare its distance with the prediction.
+  const double periods = rho > 0 ? k * std::log(0.5) / std::log(rho) : 1.0;
+  r.check_periods = static_cast<int>(
+      std::clamp(std::ceil(periods), 1.0, static_cast<double>(options.max_check_periods)));
+  r.predicted_factor = std::pow(rho, static_cast<double>(r.check_periods) / k);
+  try {
+    r.measured_factor = nearest_point(map.advance(last_state, r.check_periods)) / r.distance;
+    r.approach_confirmed = r.measured_factor <= std::sqrt(r.predicted_factor);
+  } catch (const DivergenceError&) {
+    r.approach_confirmed = false;
+  }
+}
+
+}  // namespace
 
 OrbitRefinement refine_orbit(StroboscopicMap& map, const std::vector<Vector>& points,
                              const Vector& last_state, const RefinementOptions& options) {
@@ -108,7 +152,8 @@ OrbitRefinement refine_orbit(StroboscopicMap& map, const std::vector<Vector>& po
   }
   if (!last_state.allFinite()) throw InputError("last state is not finite");
 
-  OrbitRefinement r;
+  // Every candidate in turn until an orbit explains the motion; otherwise the first orbit found.
+  OrbitRefinement r, first;
   const std::vector<int> periods = candidate_periods(points, options.max_period, options.candidates);
   for (int k : periods) {
     r.tried.push_back(k);
@@ -129,35 +174,20 @@ OrbitRefinement refine_orbit(StroboscopicMap& map, const std::vector<Vector>& po
       }
       r.found = true;
       r.orbit = std::move(orbit);
-      break;
+      assess(map, last_state, options, r);
+      if (r.explains_motion()) return r;
+      if (!first.found) first = r;
     } catch (const ShootingError& e) {
       r.failure = e.what();
     } catch (const DivergenceError& e) {
       r.failure = e.what();
     }
   }
-  if (!r.found) {
-    if (r.failure.empty()) r.failure = "no candidate period";
-    return r;
+  if (first.found) {
+    first.tried = r.tried;
+    return first;
   }
-
-  // The distance from the motion to the nearest of the orbit's k points at phase 0.
-  const int k = r.orbit.period;
-  r.tolerance = options.on_orbit_tolerance * std::max(1.0, inf_norm(r.orbit.state));
-  Vector y = r.orbit.state;
-  r.distance = inf_norm(last_state - y);
-  for (int j = 1; j < k; ++j) {
-    y = map.advance(y, 1);
-    r.distance = std::min(r.distance, inf_norm(last_state - y));
-  }
-  r.on_orbit = r.distance <= r.tolerance;
-  const FloquetMultipliers& mu = r.orbit.multipliers;
-  r.attracting = mu.converged && mu.stable();
-  const double rho = mu.largest_modulus();
-  r.contraction_per_period = rho > 0 ? std::pow(rho, 1.0 / k) : 0.0;
-  if (r.attracting && !r.on_orbit) {
-    r.periods_to_settle = rho > 0 ? k * std::log(r.tolerance / r.distance) / std::log(rho) : k;
-  }
+  if (r.failure.empty()) r.failure = "no candidate period";
   return r;
 }
 
@@ -170,10 +200,16 @@ std::string OrbitRefinement::describe() const {
     return fmt::format("{}, {} ({}): the motion is on it (distance {:.1e})", name,
                        attracting ? "attracting" : "not attracting", rate, distance);
   }
-  if (attracting) {
+  if (attracting && approach_confirmed) {
     return fmt::format("{}, attracting ({}): the motion approaches it, {:.1e} away, reached after "
                        "about {:.0f} more periods",
                        name, rate, distance, std::ceil(periods_to_settle));
+  }
+  if (attracting) {
+    return fmt::format("{}, attracting ({}), {:.1e} away, but the motion does not approach it as "
+                       "predicted (its distance changed by {:.3g} in {} periods, predicted {:.3g}): "
+                       "it does not describe the motion",
+                       name, rate, distance, measured_factor, check_periods, predicted_factor);
   }
   if (!orbit.multipliers.converged) {
     return fmt::format("{}, stability undetermined (Arnoldi did not converge; {}), {:.1e} away",

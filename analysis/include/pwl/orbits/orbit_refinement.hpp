@@ -20,7 +20,8 @@
 //     first. A period-p record also returns at every multiple of p, and a multiple can score
 //     lower (a slow drift back in phase), so each minimum k stands for its shortest divisor j
 //     whose score is within 10 times k's (plus 1e-3 of the spread), and a multiple of a period
-//     already chosen is left out (Newton for the multiple would find the shorter orbit again).
+//     chosen already (with a closer return) is left out: Newton for it finds the same orbits,
+//     reduced to their least period (step 2). A divisor is kept (its Newton is cheaper).
 //  2. Newton on φ_{kT}(y) = y (periodic_orbit.hpp) from the motion's last state, which must be at
 //     phase 0 of the forcing (a whole number of periods after the start). When it converges, the
 //     orbit's least period is checked: if φ_{jT}(y) = y for a divisor j of k (to Newton's
@@ -33,6 +34,18 @@
 //         periods to settle ≈ k · ln(tolerance / distance) / ln ρ.
 //     An orbit that is not attracting and that the motion is not on does not describe the motion
 //     (an unstable orbit inside chaos, say); it is reported as found but not as the motion's.
+//     The candidates are tried in turn until an orbit describes the motion (steps 3 and 4);
+//     when none does, the first orbit found is reported.
+//  4. That the motion does approach it. An attracting orbit Newton reaches from the last state
+//     need not be the motion's: beside a torus or a chaotic attractor a stable orbit can coexist,
+//     and Newton may converge to it from a state in the other basin. So the motion is carried on
+//     for the periods m in which the multiplier predicts its distance to shrink by half
+//     (m = k ln(1/2) / ln ρ, at most max_check_periods) and the distance it reaches is compared
+//     with the prediction: the approach is confirmed when the distance shrank by at least the
+//     square root of the predicted factor (0.71 for a half). Faster is allowed: modes that decay
+//     faster than the slowest one may still carry part of the distance. A motion on a coexisting
+//     attractor keeps its distance (a factor near 1). An attracting orbit whose approach is not
+//     confirmed does not describe the motion.
 //
 // The estimate of the periods to settle is asymptotic: it holds once the slowest mode dominates
 // the distance, and it is of the order of the truth, not an exact count (tests/orbits/
@@ -56,6 +69,8 @@ struct RefinementOptions {
   // The motion is on the orbit when its last state is within this of the orbit, relative to
   // max(1, |y|_∞); also the distance the periods to settle are counted to.
   double on_orbit_tolerance = 1e-8;
+  // Step 4: the motion is carried on for at most this many forcing periods (>= 1).
+  int max_check_periods = 20000;
   // Newton's settings; `period` is set per candidate. Multipliers are always computed.
   ShootingOptions shooting;
   bool is_valid(std::string* why) const;
@@ -64,7 +79,7 @@ struct RefinementOptions {
 struct OrbitRefinement {
   bool found = false;          // Newton converged for some candidate period
   PeriodicOrbit orbit;         // the orbit found (least period), when found
-  std::vector<int> tried;      // the candidate periods, in the order tried
+  std::vector<int> tried;      // the candidate periods tried, in order
   std::string failure;         // when not found: why (no candidate, or Newton's last message)
   double distance = 0.0;       // from the motion's last state to the nearest orbit point
   double tolerance = 0.0;      // on_orbit_tolerance · max(1, |y|_∞)
@@ -74,9 +89,17 @@ struct OrbitRefinement {
   double contraction_per_period = 0.0;
   // Attracting and not on it: about how many more forcing periods until distance <= tolerance.
   double periods_to_settle = 0.0;
+  // Step 4 (attracting, not on it): the periods the motion was carried on, the factor its
+  // distance shrank by and the factor the multiplier predicts, and whether they agree.
+  int check_periods = 0;
+  double measured_factor = 0.0;
+  double predicted_factor = 0.0;
+  bool approach_confirmed = false;
 
-  // Whether the orbit describes the motion: the motion is on it or approaching it.
-  bool explains_motion() const { return found && (on_orbit || attracting); }
+  // Whether the orbit describes the motion: the motion is on it, or approaches it as confirmed.
+  bool explains_motion() const {
+    return found && (on_orbit || (attracting && approach_confirmed));
+  }
   // One line: "period-1, attracting (|μ| = 0.998 per period): reached after about 9000 more
   // periods" and the like.
   std::string describe() const;
