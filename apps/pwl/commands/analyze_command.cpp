@@ -211,9 +211,18 @@ void analyze(const AnalyzeOptions& o) {
   // or approaching, if Newton finds one from the motion's last state (at phase 0: a whole number
   // of periods after the record), with the rate of the approach. Evidence printed beside the
   // regime, which it does not change yet.
-  if (c && (result.regime == "uncertain" || result.regime == "quasi-periodic") &&
-      s.section.stroboscopic() &&
-      result.final_state.size() == 2 * n) {
+  // Up to 20 masses: Newton carries 2n tangent columns through candidate periods of up to 300
+  // forcing periods (about 1.5 s for 5 masses by the exact solver); the cost grows like n² per
+  // period, so that beyond, `pwl orbit --period K` asks for one period instead.
+  constexpr Index kRefinementMasses = 20;
+  const bool refinable = c && (result.regime == "uncertain" || result.regime == "quasi-periodic") &&
+                         s.section.stroboscopic() && result.final_state.size() == 2 * n;
+  if (refinable && n > kRefinementMasses) {
+    fmt::print("  orbit refinement: not run for n = {} > {} masses (`pwl orbit --period K` finds "
+               "an orbit of a given period)\n",
+               n, kRefinementMasses);
+  }
+  if (refinable && n <= kRefinementMasses) {
     std::vector<Vector> points;
     for (std::size_t i = 0; (i + 1) * static_cast<std::size_t>(2 * n) <= a.section_states.size();
          ++i) {
