@@ -168,6 +168,32 @@ TEST_CASE("an attracting orbit the motion does not approach is not taken for the
   CHECK(nearest <= 1e-8);
 }
 
+TEST_CASE("a motion that keeps its distance from an attracting orbit is not taken for the orbit's",
+          "[orbits][refinement]") {
+  // A cell of the shipped (θ, α) map (figure 5's chain, α = 6.5, θ = 0.5 + 22 · 2.5/39), by the
+  // map's PIM (η = T/200): Newton finds a period-1 orbit that is attracting for the PIM's map
+  // (|μ| = 0.9973; by the exact solver it is slightly unstable, 1.0017), and the motion stays
+  // about 0.04 from it, rising and falling, for 40000 periods (pwl analyze). A check on one
+  // distance 255 periods on (an earlier version) passed it on the map's run ("approaches it,
+  // reached after about 5454 more periods"); the window maxima do not.
+  NondimensionalChain chain = paper_five_dof_case("5");
+  chain.alpha = {6.5};
+  chain.theta = 0.5 + 22 * 2.5 / 39;
+  StroboscopicMap map(analysis::PointCase(chain), MethodSettings{Method::pim}, 200);
+  const std::vector<Vector> points = pwl::test::poincare_points(map, Vector::Zero(10), 700, 300);
+  const OrbitRefinement r = refine_orbit(map, points, points.back());
+  INFO(r.describe());
+  REQUIRE(r.found);
+  REQUIRE(r.orbit.period == 1);
+  CHECK(r.attracting);
+  CHECK_FALSE(r.approach_confirmed);
+  CHECK(r.measured_factor > 0.9);
+  CHECK_FALSE(r.explains_motion());
+  // The truth: 3000 periods on, the motion is still that far from the orbit.
+  const Vector later = map.advance(points.back(), 3000);
+  CHECK(inf_norm(later - r.orbit.state) > 0.02);
+}
+
 TEST_CASE("candidate periods of a period-3 record are 3, not its multiples",
           "[orbits][refinement]") {
   std::vector<Vector> points;

@@ -103,19 +103,20 @@ namespace {
 // Steps 3 and 4 for the orbit in r: where the motion is with respect to it.
 void assess(StroboscopicMap& map, const Vector& last_state, const RefinementOptions& options,
             OrbitRefinement& r) {
-  // The distance from the motion to the nearest of the orbit's k points at phase 0.
+  // The orbit's k points at phase 0, and the one nearest the motion (its phase on the orbit).
   const int k = r.orbit.period;
-  const auto nearest_point = [&](const Vector& state) {
-    Vector y = r.orbit.state;
-    double nearest = inf_norm(state - y);
-    for (int j = 1; j < k; ++j) {
-      y = map.advance(y, 1);
-      nearest = std::min(nearest, inf_norm(state - y));
+  std::vector<Vector> orbit_points{r.orbit.state};
+  for (int j = 1; j < k; ++j) orbit_points.push_back(map.advance(orbit_points.back(), 1));
+  int phase = 0;
+  r.distance = inf_norm(last_state - orbit_points[0]);
+  for (int j = 1; j < k; ++j) {
+    const double d = inf_norm(last_state - orbit_points[static_cast<std::size_t>(j)]);
+    if (d < r.distance) {
+      r.distance = d;
+      phase = j;
     }
-    return nearest;
-  };
+  }
   r.tolerance = options.on_orbit_tolerance * std::max(1.0, inf_norm(r.orbit.state));
-  r.distance = nearest_point(last_state);
   r.on_orbit = r.distance <= r.tolerance;
   const FloquetMultipliers& mu = r.orbit.multipliers;
   r.attracting = mu.converged && mu.stable();
@@ -127,13 +128,27 @@ void assess(StroboscopicMap& map, const Vector& last_state, const RefinementOpti
   r.approach_confirmed = false;
   if (!r.attracting || r.on_orbit) return;
   r.periods_to_settle = rho > 0 ? k * std::log(r.tolerance / r.distance) / std::log(rho) : k;
-  // Step 4: carry the motion on and compare its distance with the prediction.
-  const double periods = rho > 0 ? k * std::log(0.5) / std::log(rho) : 1.0;
-  r.check_periods = static_cast<int>(
-      std::clamp(std::ceil(periods), 1.0, static_cast<double>(options.max_check_periods)));
-  r.predicted_factor = std::pow(rho, static_cast<double>(r.check_periods) / k);
+  // Step 4: carry the motion on for P + W periods (P: the multiplier halves the distance in P
+  // periods; W = P/4, at least one period) and compare the largest distance over the last W
+  // periods with the largest over the first W, which the multiplier predicts to be half of it.
+  // Window maxima, not single distances: on a torus or another attractor around the orbit the
+  // distance rises and falls along the motion, and one sample can fall low by chance.
+  const double halving = rho > 0 ? k * std::log(0.5) / std::log(rho) : 1.0;
+  const double limit = static_cast<double>(options.max_check_periods);
+  const int window = static_cast<int>(std::clamp(std::ceil(halving / 4), 1.0, limit / 5));
+  r.check_periods = static_cast<int>(std::clamp(std::ceil(halving), 1.0, limit - window)) + window;
+  r.predicted_factor = std::pow(rho, static_cast<double>(r.check_periods - window) / k);
   try {
-    r.measured_factor = nearest_point(map.advance(last_state, r.check_periods)) / r.distance;
+    Vector motion = last_state;
+    double first = r.distance, last = 0.0;
+    for (int i = 1; i <= r.check_periods; ++i) {
+      motion = map.advance(motion, 1);
+      const double d = inf_norm(
+          motion - orbit_points[static_cast<std::size_t>((phase + i) % k)]);
+      if (i < window) first = std::max(first, d);
+      if (i > r.check_periods - window) last = std::max(last, d);
+    }
+    r.measured_factor = last / first;
     r.approach_confirmed = r.measured_factor <= std::sqrt(r.predicted_factor);
   } catch (const DivergenceError&) {
     r.approach_confirmed = false;
