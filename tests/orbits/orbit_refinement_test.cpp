@@ -89,8 +89,8 @@ TEST_CASE("orbit refinement settles a gap oscillator's slow spiral onto its peri
   CHECK_FALSE(r.on_orbit);
   CHECK(r.approach_confirmed);
   pwl::test::measured("gap oscillator: distance factor measured", r.measured_factor);
-  // Of the predicted order (measured 0.38 against 0.50: the contacts' pieces still add to the
-  // slowest mode's decay half a distance out).
+  // Of the predicted order (measured 0.49 against 0.50 on the window maxima; faster is allowed,
+  // slower than the square root is not).
   CHECK(r.measured_factor <= std::sqrt(r.predicted_factor));
   CHECK(r.measured_factor >= r.predicted_factor * r.predicted_factor);
   // The truth: the same exact solver, integrated until the motion stops moving.
