@@ -67,7 +67,7 @@ analysis::SweepOptions sweep_of(const SweepBenchOptions& o) {
 double time_points(const analysis::SweepOptions& s, const std::vector<long>& ids, int threads,
                    const analysis::PointSettings& settings) {
   std::vector<analysis::GridTask> tasks;
-  for (long id : ids) tasks.push_back({{id}, false});
+  for (long id : ids) tasks.push_back({{id}, false, {}});
   const auto start = std::chrono::steady_clock::now();
   analysis::run_grid(
       tasks, [&](long id) { return s.chain_of(id); }, s.start_state(), settings, {},

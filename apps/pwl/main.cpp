@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   pwl::app::add_bench_command(app);
   pwl::app::add_sweep_command(app);
   pwl::app::add_map_command(app);
+  pwl::app::add_basin_command(app);
   pwl::app::add_orbit_command(app);
   pwl::app::add_continue_command(app);
   pwl::app::add_run_command(app);

@@ -57,6 +57,7 @@ std::unique_ptr<CLI::App> program() {
   pwl::app::add_bench_command(*app);
   pwl::app::add_sweep_command(*app);
   pwl::app::add_map_command(*app);
+  pwl::app::add_basin_command(*app);
   pwl::app::add_orbit_command(*app);
   pwl::app::add_continue_command(*app);
   pwl::app::add_run_command(*app);
@@ -224,6 +225,7 @@ const std::map<std::string, std::vector<std::string>>& base_arguments() {
       {"analyze", {"--out", "D"}},
       {"sweep", {"--quiet", "--no-plot", "--out", "D"}},
       {"map", {"--quiet", "--no-plot", "--out", "D"}},
+      {"basin", {"--quiet", "--no-plot", "--out", "D"}},
       {"orbit", {"--quiet", "--out", "D"}},
       {"continue",
        {"--parameter", "theta", "--range", "0.9:1", "--no-plot", "--quiet", "--out", "D"}},

@@ -293,6 +293,19 @@ TEST_CASE("the step guard accepts the paper's settings and every shipped scene's
   scenes["five_dof_orbit"] = {chain_at("4a", 0, 0)};
   scenes["theta_alpha_map"] = theta_range(1.0);
   for (Case& c : theta_range(15.0)) scenes["theta_alpha_map"].push_back(std::move(c));
+  {
+    // The hardening oscillator of the basin scene: one mass, α = 3, θ = 1.2, η = T/200.
+    NondimensionalChain hardening;
+    hardening.masses = 1;
+    hardening.alpha = {3.0};
+    hardening.zeta = 0.1;
+    hardening.gap = {1.5};
+    hardening.amplitude = {0.5};
+    hardening.theta = 1.2;
+    scenes["hardening_basins"] = {Case{make_chain(hardening),
+                                       fixed_step(Method::pim, hardening.period() / 200),
+                                       hardening.period()}};
+  }
   scenes["two_mass_stop"] = {stop_case};
   scenes["two_mass_stop_gap_sweep"] = {stop_case};  // the gaps do not change ω_max
   scenes["bench_chain"] = {paper_chain};

@@ -54,7 +54,8 @@ GridEnd run_grid(const std::vector<GridTask>& tasks, const PointCaseOf& case_of,
     try {
       const GridTask& task = tasks[static_cast<std::size_t>(t)];
       StopCheck check(should_stop);
-      Vector state = initial_state;
+      const Vector& start = task.start.size() != 0 ? task.start : initial_state;
+      Vector state = start;
       for (long id : task.ids) {
         if (should_stop()) break;
         const auto found = done.find(id);
@@ -63,7 +64,7 @@ GridEnd run_grid(const std::vector<GridTask>& tasks, const PointCaseOf& case_of,
         if (found != done.end()) {
           result = &found->second;
         } else {
-          computed = evaluate_point(case_of(id), task.continuation ? state : initial_state,
+          computed = evaluate_point(case_of(id), task.continuation ? state : start,
                                     settings, &check);
           result = &computed;
           // An exception must not leave a critical construct: catch it inside, throw outside.
@@ -79,8 +80,7 @@ GridEnd run_grid(const std::vector<GridTask>& tasks, const PointCaseOf& case_of,
           if (sink_failure) std::rethrow_exception(sink_failure);
         }
         if (task.continuation) {
-          state = result->final_state.size() == initial_state.size() ? result->final_state
-                                                                    : initial_state;
+          state = result->final_state.size() == start.size() ? result->final_state : start;
         }
       }
     } catch (const Abandoned&) {

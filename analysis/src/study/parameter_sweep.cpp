@@ -78,16 +78,16 @@ double SweepOptions::value(int index) const {
 std::vector<GridTask> SweepOptions::tasks() const {
   std::vector<GridTask> result;
   if (mode == SweepMode::independent) {
-    for (int i = 0; i < points; ++i) result.push_back({{i}, false});
+    for (int i = 0; i < points; ++i) result.push_back({{i}, false, {}});
     return result;
   }
   if (upward) {
-    GridTask up{{}, true};
+    GridTask up{{}, true, {}};
     for (int i = 0; i < points; ++i) up.ids.push_back(i);
     result.push_back(std::move(up));
   }
   if (downward) {
-    GridTask down{{}, true};
+    GridTask down{{}, true, {}};
     for (int i = points - 1; i >= 0; --i) down.ids.push_back(points + i);
     result.push_back(std::move(down));
   }

@@ -75,11 +75,11 @@ bool RegimeMapOptions::is_valid(std::string* why) const {
 std::vector<GridTask> RegimeMapOptions::tasks() const {
   std::vector<GridTask> result;
   if (mode == SweepMode::independent) {
-    for (long id = 0; id < cells(); ++id) result.push_back({{id}, false});
+    for (long id = 0; id < cells(); ++id) result.push_back({{id}, false, {}});
     return result;
   }
   for (int j = 0; j < second.points; ++j) {
-    GridTask row{{}, true};
+    GridTask row{{}, true, {}};
     for (int i = 0; i < first.points; ++i) row.ids.push_back(i + static_cast<long>(first.points) * j);
     result.push_back(std::move(row));
   }

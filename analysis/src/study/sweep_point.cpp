@@ -60,6 +60,10 @@ bool PointSettings::is_valid(int dofs, std::string* why) const {
                        steps_per_period, row.name);
     return false;
   }
+  if (kept_points < 0) {
+    *why = fmt::format("kept points = {} must be >= 0 (0: every recorded point)", kept_points);
+    return false;
+  }
   for (int c : components) {
     if (c < 0 || c >= 2 * dofs) {
       *why = fmt::format("component {} is out of range: the state has {} components (0..{})", c,
@@ -104,6 +108,8 @@ std::string PointSettings::describe() const {
                      section.hyperplane.component, section.hyperplane.level, direction);
   }
   if (section.phase != 0.0) s += fmt::format("phase = {:.17g}\n", section.phase);
+  // Stated only when set, as the section: descriptions from before it read the same.
+  if (kept_points != 0) s += fmt::format("kept_points = {}\n", kept_points);
   return s;
 }
 
@@ -175,6 +181,21 @@ void two_trajectory_lyapunov(const PointCase& point, const MethodSettings& metho
   } catch (const DivergenceError&) {
   } catch (const LcpError&) {
   } catch (const BudgetError&) {
+  }
+}
+
+// Drops all but the last `kept` recorded points (0: keeps them all).
+void keep_last_points(int kept, PointResult& result) {
+  if (kept <= 0) return;
+  const std::size_t rows = result.columns == 0 ? result.section_times.size()
+                                               : result.poincare.size() / result.columns;
+  if (rows <= static_cast<std::size_t>(kept)) return;
+  const std::size_t dropped = rows - static_cast<std::size_t>(kept);
+  result.poincare.erase(result.poincare.begin(),
+                        result.poincare.begin() + static_cast<std::ptrdiff_t>(dropped) * result.columns);
+  if (!result.section_times.empty()) {
+    result.section_times.erase(result.section_times.begin(),
+                               result.section_times.begin() + static_cast<std::ptrdiff_t>(dropped));
   }
 }
 
@@ -260,6 +281,7 @@ PointResult evaluate_point(const PointCase& point, const Vector& initial_state,
       points.push_back(std::move(strobe.state));
     }
     if (hyperplane) sampler.record_crossings(nullptr);
+    keep_last_points(s.kept_points, result);
     if (s.section.phase == 0.0) {
       result.final_state = points.back();
     } else {

@@ -11,6 +11,7 @@ void add_reproduce_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_sweep_command(CLI::App& app);
 void add_map_command(CLI::App& app);
+void add_basin_command(CLI::App& app);
 void add_orbit_command(CLI::App& app);
 void add_continue_command(CLI::App& app);
 

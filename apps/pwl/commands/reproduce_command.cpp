@@ -280,7 +280,7 @@ void add_reproduce_command(CLI::App& app) {
   c->add_option("--plots", options->plots, "Plots folder: figures/, data/ and report.md (default: plots/)");
   c->add_flag("--quick", options->quick, "Short runs, for smoke tests");
   c->add_option("--only", options->only,
-                "Only these: 4a, 4b, 5, 6, 7-9, theta-sweep, theta-alpha-map")
+                "Only these: 4a, 4b, 5, 6, 7-9, theta-sweep, theta-alpha-map, continuation, basins")
       ->delimiter(',');
   c->callback([options] { reproduce(*options); });
 }

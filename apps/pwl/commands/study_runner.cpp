@@ -66,6 +66,18 @@ analysis::SweepParameter parse_model_parameter(const analysis::PointModel& model
   }
 }
 
+int parse_component(const std::string& flag, const std::string& name, int masses) {
+  if (name.size() >= 2 && (name[0] == 'x' || name[0] == 'v')) {
+    char* end = nullptr;
+    const long i = std::strtol(name.c_str() + 1, &end, 10);
+    if (*end == '\0' && i >= 1 && i <= masses) {
+      return static_cast<int>(i - 1) + (name[0] == 'v' ? masses : 0);
+    }
+  }
+  throw InputError(fmt::format("{} {}: name a state component x1..x{} or v1..v{}", flag, name,
+                               masses, masses));
+}
+
 analysis::PointSettings PointFlags::settings(int masses) const {
   analysis::PointSettings s;
   s.transient_periods = transient;
@@ -78,21 +90,7 @@ analysis::PointSettings PointFlags::settings(int masses) const {
   s.method.tolerance = tolerance;
   s.method.locate_kinks = locate_kinks;
   s.method.lcp = parse_lcp_algorithm(lcp_solver);
-  for (const std::string& name : record) {
-    int component = -1;
-    if (name.size() >= 2 && (name[0] == 'x' || name[0] == 'v')) {
-      char* end = nullptr;
-      const long i = std::strtol(name.c_str() + 1, &end, 10);
-      if (*end == '\0' && i >= 1 && i <= masses) {
-        component = static_cast<int>(i - 1) + (name[0] == 'v' ? masses : 0);
-      }
-    }
-    if (component < 0) {
-      throw InputError(fmt::format("--record {}: name a state component x1..x{} or v1..v{}", name,
-                                   masses, masses));
-    }
-    s.components.push_back(component);
-  }
+  for (const std::string& name : record) s.components.push_back(parse_component("--record", name, masses));
   if (record.empty()) s.components = {masses - 1, 2 * masses - 1};
   std::string why;
   if (!s.is_valid(masses, &why)) throw InputError(why);
@@ -496,21 +494,21 @@ std::string study_title(const analysis::PointModel& model, const analysis::Point
       method.fixed_grid ? fmt::format("{}η = T/{}", named, point.steps_per_period)
                         : method_label(point.method);
   std::string base;
+  const auto count = [](auto k, const char* one, const char* many) {
+    return fmt::format("{} {}", k, k == 1 ? one : many);
+  };
   if (model.explicit_structure()) {
     const GapStructure& g = model.structure().structure;
     // Underscores of the file name escaped: gnuplot's enhanced text reads '_' as a subscript.
     std::string label;
     for (char ch : model.structure().label) label += ch == '_' ? std::string("\\_") : std::string(1, ch);
-    const auto count = [](auto k, const char* one, const char* many) {
-      return fmt::format("{} {}", k, k == 1 ? one : many);
-    };
     base = fmt::format("base case: {}, {}, {}, {}", label, count(g.dofs(), "mass", "masses"),
                        count(g.springs.size(), "gap spring", "gap springs"),
                        count(g.loads.size(), "load", "loads"));
   } else {
     const NondimensionalChain& chain = model.chain();
-    base = fmt::format("base case: {} masses, α = {}, ζ = {}, Δ̃ = {}, θ = {}, Q = ({})",
-                       chain.masses, fmt::join(chain.alpha, ","), chain.zeta,
+    base = fmt::format("base case: {}, α = {}, ζ = {}, Δ̃ = {}, θ = {}, Q = ({})",
+                       count(chain.masses, "mass", "masses"), fmt::join(chain.alpha, ","), chain.zeta,
                        fmt::join(chain.gap, ","), chain.theta, fmt::join(chain.amplitude, ","));
   }
   std::string title = fmt::format("{}; {} + {} periods per point, {}", base,

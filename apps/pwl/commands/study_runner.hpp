@@ -120,6 +120,10 @@ void run_study(const Study& study, const RunFlags& flags);
 std::map<long, analysis::PointResult> compute_study(const Study& study, int threads = 0,
                                                     bool force = false);
 
+// The 0-based state component named `name` (x1..xn, v1..vn) of a structure of `masses` degrees
+// of freedom; InputError naming the flag and the value otherwise.
+int parse_component(const std::string& flag, const std::string& name, int masses);
+
 // Parses a range "a:b" into its ends; throws InputError naming the flag otherwise.
 void parse_range(const std::string& flag, const std::string& text, double* from, double* to);
 

@@ -60,6 +60,11 @@ const std::vector<ReproducedScene>& reproduced_scenes() {
         "run.transient=50"},
        {{"frequency_response", "frequency_response_theta"},
         {"branch_over_diagram", "branches_over_diagram_theta"}}},
+      {"basins",
+       "hardening_basins.toml",
+       {},
+       {"basin.x_points=21", "basin.y_points=21", "run.transient=100", "run.periods=40"},
+       {{"basin", "basins_hardening_oscillator"}}},
   };
   return scenes;
 }

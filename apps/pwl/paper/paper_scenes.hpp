@@ -13,7 +13,7 @@ namespace pwl::app {
 
 struct ReproducedScene {
   std::string key;    // for --only: "4a", "4b", "5", "6", "7-9", "theta-sweep", "theta-alpha-map",
-                      // "continuation"
+                      // "continuation", "basins"
   std::string scene;  // file name in the scenes folder
   // --set overrides of every run (the paper's figure title) and of a smoke run (--quick: shorter
   // runs, smaller grids).

@@ -329,7 +329,7 @@ std::string screen_scene_text(std::string_view text, const std::string& name) {
 const std::vector<std::string>& scene_sections() {
   static const std::vector<std::string> sections{
       "structure", "method", "run",   "analysis",     "sweep",
-      "map",       "orbit",  "bench", "continuation", "output"};
+      "map",       "orbit",  "bench", "continuation", "output", "basin"};
   return sections;
 }
 

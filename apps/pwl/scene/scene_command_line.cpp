@@ -254,8 +254,8 @@ void add_run_command(CLI::App& app) {
   static std::vector<std::string> unused_overrides;
   CLI::App* c =
       app.add_subcommand("run",
-                         "Run the job a scene file describes (simulate, analyze, sweep, map, orbit,\n"
-                         "continue or a benchmark)\n"
+                         "Run the job a scene file describes (simulate, analyze, sweep, map, basin,\n"
+                         "orbit, continue or a benchmark)\n"
                          "Example: pwl run apps/scenes/paper_fig4b.toml --set structure.theta=1.1");
   c->add_option("scene", unused_path, "The scene file")->required();
   c->add_option("--set", unused_overrides, "Override one scene setting: key=value");

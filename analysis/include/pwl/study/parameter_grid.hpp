@@ -23,6 +23,9 @@ namespace pwl::analysis {
 struct GridTask {
   std::vector<long> ids;      // in the order they are computed
   bool continuation = false;  // each point starts from the previous point's final state
+  // The state the task's first point starts from ([x; v]); empty: the study's initial state. A
+  // basin map gives every cell its own.
+  Vector start;
 };
 
 // The case of point `id`: its structure and forcing period (a NondimensionalChain converts).
@@ -47,7 +50,8 @@ enum class GridEnd {
 
 // Computes every point of `tasks` that is not in `done`. A continuation that meets a point in
 // `done` takes its final state from there (a resumed run continues where the killed one stopped);
-// after a point whose motion blew up (no final state) it restarts from `initial_state`.
+// after a point whose motion blew up (no final state) it restarts from `initial_state` (or the
+// task's own start).
 // Exceptions from a point (bad input) or from the sink (a journal that cannot be written) stop
 // the other threads as run.stop does and are rethrown on the calling thread after the loop.
 GridEnd run_grid(const std::vector<GridTask>& tasks, const PointCaseOf& case_of,

@@ -67,6 +67,11 @@ struct PointSettings {
   // 0-based state components kept in PointResult::poincare: 0..n-1 are x1..xn, n..2n-1 are
   // v1..vn. May be empty (a regime map keeps only the indicators).
   std::vector<int> components;
+  // How many of the recorded points are kept: 0 every one, N > 0 only the last N (the last N
+  // periods of a stroboscopic section, the last N crossings of a hyperplane). All of them are
+  // classified either way. A basin map matches attractors on a short tail of each cell's motion
+  // and keeps no more than that.
+  int kept_points = 0;
   // The section recorded; its phase is also that of the stroboscopic points classified. Period k
   // (1-based) of the integration ends at t = (k + phase) T.
   PoincareSection section;
