@@ -29,12 +29,16 @@ void set_integer(PointResult& r, const IndicatorValue& v) {
 }
 IndicatorValue get_regime(const PointResult& r) { return r.regime; }
 void set_regime(PointResult& r, const IndicatorValue& v) { r.regime = std::get<std::string>(v); }
+IndicatorValue get_confirmed_by(const PointResult& r) { return r.confirmed_by; }
+void set_confirmed_by(PointResult& r, const IndicatorValue& v) {
+  r.confirmed_by = std::get<std::string>(v);
+}
 IndicatorValue get_code(const PointResult& r) {
   return static_cast<long>(regime_code(r.regime, r.period));
 }
 
 // The table. Append new rows at the end: the result files' existing columns keep their places.
-constexpr std::array<Indicator, 6> kIndicators{{
+constexpr std::array<Indicator, 9> kIndicators{{
     {"regime", "the classified motion: period-k, quasi-periodic, chaotic, unbounded, uncertain",
      IndicatorType::text, false, "failed", get_regime, set_regime},
     {"code", "the regime as a small integer for colour maps (regime_code)", IndicatorType::integer,
@@ -48,6 +52,19 @@ constexpr std::array<Indicator, 6> kIndicators{{
      set_real<&PointResult::lambda1_error>},
     {"K", "K of the 0-1 test for chaos on the observable (near 0 regular, near 1 chaotic)",
      IndicatorType::real, false, "", get_real<&PointResult::K>, set_real<&PointResult::K>},
+    {"settle_periods",
+     "orbit refinement settled the regime: forcing periods still needed to reach the orbit (0: on "
+     "it); empty when the regime is the record's own",
+     IndicatorType::real, false, "", get_real<&PointResult::settle_periods>,
+     set_real<&PointResult::settle_periods>},
+    {"extra_periods",
+     "adaptive evidence: periods recorded beyond the setting because the indicators disagreed",
+     IndicatorType::integer, false, "", get_integer<&PointResult::extra_periods>,
+     set_integer<&PointResult::extra_periods>},
+    {"confirmed_by",
+     "the method whose run decided the point when an approximate method's verdict was checked "
+     "(exact); empty otherwise",
+     IndicatorType::text, false, "", get_confirmed_by, set_confirmed_by},
 }};
 
 std::string cell(const Indicator& indicator, const PointResult& r) {

@@ -10,6 +10,7 @@
 #include "pwl/analysis/lyapunov.hpp"
 #include "pwl/analysis/zero_one_test.hpp"
 #include "pwl/errors.hpp"
+#include "pwl/orbits/orbit_refinement.hpp"
 #include "pwl/integrators/method_table.hpp"
 #include "pwl/study/section_sampler.hpp"
 
@@ -58,6 +59,16 @@ bool PointSettings::is_valid(int dofs, std::string* why) const {
   if (row.fixed_grid && steps_per_period < 1) {
     *why = fmt::format("steps per period = {} must be >= 1 ({} steps on a fixed grid)",
                        steps_per_period, row.name);
+    return false;
+  }
+  if (evidence_periods < 0) {
+    *why = fmt::format("evidence periods = {} must be >= 0 (0: no longer records)",
+                       evidence_periods);
+    return false;
+  }
+  if (refine_max_period < 0 || refine_max_period > 1000) {
+    *why = fmt::format("refine max period = {} must be in 0..1000 (0: no orbit refinement)",
+                       refine_max_period);
     return false;
   }
   if (kept_points < 0) {
@@ -110,6 +121,9 @@ std::string PointSettings::describe() const {
   if (section.phase != 0.0) s += fmt::format("phase = {:.17g}\n", section.phase);
   // Stated only when set, as the section: descriptions from before it read the same.
   if (kept_points != 0) s += fmt::format("kept_points = {}\n", kept_points);
+  if (refine_max_period != 0) s += fmt::format("refine_max_period = {}\n", refine_max_period);
+  if (evidence_periods != 0) s += fmt::format("evidence_periods = {}\n", evidence_periods);
+  if (confirm != Confirmation::none) s += fmt::format("confirm = {}\n", confirmation_name(confirm));
   return s;
 }
 
@@ -199,10 +213,34 @@ void keep_last_points(int kept, PointResult& result) {
   }
 }
 
-}  // namespace
+// Orbit refinement of a quasi-periodic or uncertain record (PointSettings::refine_max_period):
+// the regime becomes period-k when Newton's orbit describes the motion (the motion is on it, or
+// confirmed to approach it). A failure of the refinement itself (an iterate that blows up, an
+// unsolvable LCP) leaves the record's verdict.
+void refine_regime(const PointCase& point, const PointSettings& s, const std::vector<Vector>& points,
+                   PointResult& result) {
+  const Index n = point.structure.dofs();
+  if (s.refine_max_period <= 0 || n > PointSettings::kRefinedMasses) return;
+  if (result.regime != "quasi-periodic" && result.regime != "uncertain") return;
+  if (result.final_state.size() != 2 * n) return;
+  orbits::RefinementOptions options;
+  options.max_period = s.refine_max_period;
+  try {
+    orbits::StroboscopicMap map(point, s.method, s.steps_per_period);
+    const orbits::OrbitRefinement r = orbits::refine_orbit(map, points, result.final_state, options);
+    if (!r.explains_motion()) return;
+    result.regime = regime_name(Regime::periodic, r.orbit.period);
+    result.period = r.orbit.period;
+    result.settle_periods = r.on_orbit ? 0.0 : r.periods_to_settle;
+  } catch (const DivergenceError&) {
+  } catch (const LcpError&) {
+  } catch (const BudgetError&) {
+  }
+}
 
-PointResult evaluate_point(const PointCase& point, const Vector& initial_state,
-                           const PointSettings& s, PointObserver* observer) {
+// One evaluation with the settings' method: the record, adaptive evidence and refinement.
+PointResult evaluate_record(const PointCase& point, const Vector& initial_state,
+                            const PointSettings& s, PointObserver* observer) {
   const GapStructure& structure = point.structure;
   const Index n = structure.dofs();
   std::string why;
@@ -252,14 +290,9 @@ PointResult evaluate_point(const PointCase& point, const Vector& initial_state,
     result.section_times.push_back(c.t);
     if (observer != nullptr) observer->poincare_point(k, c.t, c.state);
   };
-  try {
-    for (int k = 1; k <= s.transient_periods; ++k) {
-      period_now = k;
-      if (hyperplane && k == s.transient_periods) sampler.record_crossings(record_crossing);
-      sampler.advance_to_strobe(k, nullptr, steps_of(k));
-    }
-    if (hyperplane && s.transient_periods == 0) sampler.record_crossings(record_crossing);
-    for (int k = s.transient_periods + 1; k <= total; ++k) {
+  // Records periods first..last (1-based from the start) as the record's points.
+  const auto record = [&](int first, int last) {
+    for (int k = first; k <= last; ++k) {
       period_now = k;
       StrobePoint strobe;
       if (frame) {
@@ -280,77 +313,185 @@ PointResult evaluate_point(const PointCase& point, const Vector& initial_state,
       }
       points.push_back(std::move(strobe.state));
     }
+  };
+  const int observable = s.observable >= 0 ? s.observable : static_cast<int>(n) - 1;
+  // Classifies the record so far: λ1 over its Jacobians, K on the observable, the classifier.
+  const auto classify = [&]() {
+    const int recorded = static_cast<int>(points.size());
+    result.lambda1 = result.lambda1_error = result.K = std::numeric_limits<double>::quiet_NaN();
+    MotionEvidence evidence;
+    // The first classified point is the strobe of period transient + 1, at
+    // (transient + 1 + phase) T from the initial state: the time the growth test (rule 4a of the
+    // classifier) measures the amplitude's power of t against.
+    evidence.first_point_time = sampler.strobe_time(s.transient_periods + 1) / period;
+    if (tangent) {
+      LyapunovOptions l;
+      const Averaging a = averaging(static_cast<long>(jacobians.size()), recorded);
+      l.transient = a.transient;
+      l.iterations = a.iterations;
+      l.blocks = a.blocks;
+      l.time_per_iteration = period;
+      if (a.enough()) {
+        const LyapunovResult spectrum = lyapunov_spectrum(jacobians, l);
+        result.lambda1 = spectrum.largest();
+        result.lambda1_error = spectrum.error[0];
+      }
+    } else if (lyapunov && s.lyapunov_estimate == LyapunovEstimate::two_trajectories) {
+      two_trajectory_lyapunov(point, method, s.section.phase, points, recorded, result);
+    }
+    if (std::isfinite(result.lambda1) && std::isfinite(result.lambda1_error)) {
+      evidence.lyapunov = result.lambda1;
+      evidence.lyapunov_error = result.lambda1_error;
+    } else {
+      result.lambda1 = result.lambda1_error = std::numeric_limits<double>::quiet_NaN();
+    }
+    ZeroOneOptions zero_one;
+    // K of the observable sampled every `stride` points.
+    const auto K_every = [&](int stride) {
+      std::vector<double> series;
+      series.reserve(points.size() / static_cast<std::size_t>(stride) + 1);
+      for (std::size_t i = points.size() % stride; i < points.size(); i += stride) {
+        series.push_back(points[i][observable]);
+      }
+      return zero_one_test(series, zero_one).K;
+    };
+    if (recorded >= zero_one.min_samples) {
+      result.K = K_every(1);
+      evidence.zero_one_K = result.K;
+    }
+    ClassifierOptions options;
+    options.fixed_point_is_equilibrium = false;  // a stroboscopic map: a fixed point is period-1
+    options.observable_component = observable;
+    options.zero_one_from_points = false;
+    Classification verdict = classify_motion(points, evidence, options);
+    // Banded chaos: a chaotic motion that visits k bands in turn (near a period-k orbit) has a
+    // strong period-k component that holds K of the whole series near 0 over any practical
+    // record (Gottwald and Melbourne, "The 0-1 test for chaos: a review", Lect. Notes Phys. 915,
+    // 2016, on signals with a strong periodic component). An uncertain verdict with λ1 > 0 is
+    // therefore tested again on every k-th point, k the period search's best near-return: the
+    // band hopping is gone from that series, the chaos within a band is not, and a torus stays
+    // regular. The larger K is the one reported.
+    const int stride = verdict.period_search.best_k;
+    if (verdict.regime == Regime::uncertain && stride > 1 && evidence.lyapunov &&
+        *evidence.lyapunov - evidence.lyapunov_error > options.lyapunov_margin &&
+        recorded / stride >= zero_one.min_samples) {
+      const double banded = K_every(stride);
+      if (banded > result.K) {
+        result.K = banded;
+        evidence.zero_one_K = banded;
+        verdict = classify_motion(points, evidence, options);
+      }
+    }
+    return verdict;
+  };
+  Classification c;
+  try {
+    for (int k = 1; k <= s.transient_periods; ++k) {
+      period_now = k;
+      if (hyperplane && k == s.transient_periods) sampler.record_crossings(record_crossing);
+      sampler.advance_to_strobe(k, nullptr, steps_of(k));
+    }
+    if (hyperplane && s.transient_periods == 0) sampler.record_crossings(record_crossing);
+    record(s.transient_periods + 1, total);
     if (hyperplane) sampler.record_crossings(nullptr);
+    c = classify();
+    // Adaptive evidence: an uncertain record is carried on, each time doubling it, until the
+    // indicators agree or the budget is spent (stroboscopic sections only: a hyperplane's
+    // crossings are recorded over the periods set in advance).
+    int end = total;
+    while (c.regime == Regime::uncertain && !hyperplane && result.extra_periods < s.evidence_periods) {
+      const int add = std::min(static_cast<int>(points.size()),
+                               s.evidence_periods - result.extra_periods);
+      record(end + 1, end + add);
+      end += add;
+      result.extra_periods += add;
+      c = classify();
+    }
     keep_last_points(s.kept_points, result);
     if (s.section.phase == 0.0) {
       result.final_state = points.back();
     } else {
       // On to the next whole period, where the loads are at phase 0 again.
-      sampler.advance_to(static_cast<double>(total + 1) * period);
+      sampler.advance_to(static_cast<double>(end + 1) * period);
       result.final_state.resize(2 * n);
       result.final_state << integrator->position(), integrator->velocity();
     }
   } catch (const DivergenceError&) {
     result.regime = "unbounded";
     result.final_state.resize(0);
+    result.lambda1 = result.lambda1_error = result.K = std::numeric_limits<double>::quiet_NaN();
     return result;
   } catch (const LcpError&) {
     result.regime = "failed";
     result.final_state.resize(0);
+    result.lambda1 = result.lambda1_error = result.K = std::numeric_limits<double>::quiet_NaN();
     return result;
   } catch (const BudgetError&) {
     // The exact solver spent its work budget on one period (contacts too stiff for it): this
     // point failed, the study goes on.
     result.regime = "failed";
     result.final_state.resize(0);
+    result.lambda1 = result.lambda1_error = result.K = std::numeric_limits<double>::quiet_NaN();
     return result;
   }
-
-  MotionEvidence evidence;
-  // The first classified point is the strobe of period transient + 1, at (transient + 1 + phase) T
-  // from the initial state: the time the growth test (rule 4a of the classifier) measures the
-  // amplitude's power of t against.
-  evidence.first_point_time = sampler.strobe_time(s.transient_periods + 1) / period;
-  if (tangent) {
-    LyapunovOptions l;
-    const Averaging a = averaging(static_cast<long>(jacobians.size()), s.recorded_periods);
-    l.transient = a.transient;
-    l.iterations = a.iterations;
-    l.blocks = a.blocks;
-    l.time_per_iteration = period;
-    if (a.enough()) {
-      const LyapunovResult spectrum = lyapunov_spectrum(jacobians, l);
-      result.lambda1 = spectrum.largest();
-      result.lambda1_error = spectrum.error[0];
-    }
-  } else if (lyapunov && s.lyapunov_estimate == LyapunovEstimate::two_trajectories) {
-    two_trajectory_lyapunov(point, method, s.section.phase, points, s.recorded_periods, result);
-  }
-  if (std::isfinite(result.lambda1) && std::isfinite(result.lambda1_error)) {
-    evidence.lyapunov = result.lambda1;
-    evidence.lyapunov_error = result.lambda1_error;
-  } else {
-    result.lambda1 = result.lambda1_error = std::numeric_limits<double>::quiet_NaN();
-  }
-  const int observable = s.observable >= 0 ? s.observable : static_cast<int>(n) - 1;
-  ZeroOneOptions zero_one;
-  if (static_cast<int>(points.size()) >= zero_one.min_samples) {
-    std::vector<double> series;
-    series.reserve(points.size());
-    for (const Vector& p : points) series.push_back(p[observable]);
-    result.K = zero_one_test(series, zero_one).K;
-    evidence.zero_one_K = result.K;
-  }
-  ClassifierOptions options;
-  options.fixed_point_is_equilibrium = false;  // a stroboscopic map: a fixed point is period-1
-  options.observable_component = observable;
-  options.zero_one_from_points = false;
-  const Classification c = classify_motion(points, evidence, options);
   result.regime = c.name();
   result.period = c.regime == Regime::periodic ? c.period : 0;
   if (c.regime == Regime::unbounded || !result.final_state.allFinite()) result.final_state.resize(0);
+  refine_regime(point, s, points, result);
   if (observer != nullptr) observer->classified(c, result);
   return result;
+}
+
+bool needs_confirmation(const PointSettings& s, const PointResult& r) {
+  switch (s.confirm) {
+    case Confirmation::none:
+      return false;
+    case Confirmation::uncertain:
+      return r.regime == "uncertain";
+    case Confirmation::aperiodic:
+      return r.regime == "uncertain" || r.regime == "chaotic" || r.regime == "quasi-periodic";
+  }
+  return false;
+}
+
+}  // namespace
+
+std::string confirmation_name(Confirmation confirmation) {
+  switch (confirmation) {
+    case Confirmation::none:
+      return "none";
+    case Confirmation::uncertain:
+      return "uncertain";
+    case Confirmation::aperiodic:
+      return "aperiodic";
+  }
+  return "none";
+}
+
+Confirmation parse_confirmation(const std::string& name) {
+  for (Confirmation c : {Confirmation::none, Confirmation::uncertain, Confirmation::aperiodic}) {
+    if (confirmation_name(c) == name) return c;
+  }
+  throw InputError(fmt::format("confirmation '{}': expected none, uncertain or aperiodic", name));
+}
+
+PointResult evaluate_point(const PointCase& point, const Vector& initial_state,
+                           const PointSettings& s, PointObserver* observer) {
+  PointResult result = evaluate_record(point, initial_state, s, observer);
+  const Index n = point.structure.dofs();
+  if (!needs_confirmation(s, result) || s.method.method == Method::exact ||
+      n > PointSettings::kRefinedMasses) {
+    return result;
+  }
+  PointSettings exact = s;
+  exact.method = MethodSettings{Method::exact};
+  exact.confirm = Confirmation::none;
+  std::string why;
+  if (!exact.method_for(point.period).is_valid(point.structure, &why)) return result;
+  PointResult confirmed = evaluate_record(point, initial_state, exact, observer);
+  if (confirmed.regime == "failed") return result;
+  confirmed.confirmed_by = "exact";
+  return confirmed;
 }
 
 }  // namespace pwl::analysis

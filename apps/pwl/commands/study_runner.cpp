@@ -90,6 +90,9 @@ analysis::PointSettings PointFlags::settings(int masses) const {
   s.method.tolerance = tolerance;
   s.method.locate_kinks = locate_kinks;
   s.method.lcp = parse_lcp_algorithm(lcp_solver);
+  s.refine_max_period = refine_orbits;
+  s.evidence_periods = evidence_periods;
+  s.confirm = analysis::parse_confirmation(confirm);
   for (const std::string& name : record) s.components.push_back(parse_component("--record", name, masses));
   if (record.empty()) s.components = {masses - 1, 2 * masses - 1};
   std::string why;
@@ -120,6 +123,22 @@ void add_point_flags(CLI::App& c, PointFlags& f, bool with_record) {
              "dopri5/rkf78: end a step exactly at every spring opening or closing");
   c.add_option("--lcp", f.lcp_solver, "PIM's LCP solver: block-pivoting or lemke")
       ->check(CLI::IsMember({"block-pivoting", "lemke"}));
+  c.add_option("--refine-orbits", f.refine_orbits,
+               "Orbit refinement of quasi-periodic and uncertain points (up to 20 masses): Newton\n"
+               "on the stroboscopic map at candidate periods up to this many forcing periods; a\n"
+               "periodic orbit the motion is on or is confirmed to approach makes the point\n"
+               "period-k (settle_periods: the periods it still needs). 0: off (default)")
+      ->check(number_in(0, 1000));
+  c.add_option("--evidence-periods", f.evidence_periods,
+               "Adaptive evidence: an uncertain point records longer, doubling its record, until\n"
+               "its indicators agree or this many more periods are spent (extra_periods). 0: off\n"
+               "(default)")
+      ->check(non_negative_number());
+  c.add_option("--confirm", f.confirm,
+               "Verdicts of an approximate method (the PIM) the exact event-driven solver checks by\n"
+               "running the point again (up to 20 masses): none (default), uncertain, or aperiodic\n"
+               "(uncertain, chaotic and quasi-periodic); confirmed_by says which did")
+      ->check(CLI::IsMember({"none", "uncertain", "aperiodic"}));
 }
 
 void add_run_flags(CLI::App& c, RunFlags& f) {
@@ -172,7 +191,7 @@ std::string first_difference(const std::string& recorded, const std::string& now
 // The format of the journals (sweep_journal.hpp), recorded in config.txt after the study's
 // description. A folder whose config.txt lacks it holds journals whose checksums leave the ids
 // out, which this version does not read.
-constexpr std::string_view kJournalFormat = "journal_format = 2\n";
+constexpr std::string_view kJournalFormat = "journal_format = 3\n";
 
 std::vector<fs::path> journal_files(const fs::path& folder) {
   std::vector<fs::path> files;
@@ -515,6 +534,15 @@ std::string study_title(const analysis::PointModel& model, const analysis::Point
                                   point.transient_periods, point.recorded_periods, integration);
   if (!point.section.is_default()) {
     title += fmt::format("; section {}", point.section.label(model.dofs()));
+  }
+  // The verdict's helpers, briefly (the README says what each does).
+  if (point.evidence_periods > 0) title += fmt::format("; evidence +{}", point.evidence_periods);
+  if (point.confirm != analysis::Confirmation::none) {
+    title += point.confirm == analysis::Confirmation::uncertain ? ", exact check"
+                                                                : ", exact check (aperiodic)";
+  }
+  if (point.refine_max_period > 0) {
+    title += fmt::format(", refinement <= {}", point.refine_max_period);
   }
   title.erase(std::remove(title.begin(), title.end(), '\''), title.end());
   return title;

@@ -68,6 +68,9 @@ struct PointFlags {
   double tolerance = 1e-10;
   bool locate_kinks = false;
   std::string lcp_solver = "block-pivoting";
+  int refine_orbits = 0;  // longest candidate period of orbit refinement; 0: none
+  int evidence_periods = 0;  // adaptive evidence budget; 0: none
+  std::string confirm = "none";  // verdicts the exact solver checks: none, uncertain, aperiodic
   // Throws InputError for a bad name or value.
   analysis::PointSettings settings(int dofs) const;
 };

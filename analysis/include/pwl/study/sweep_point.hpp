@@ -58,6 +58,19 @@ LyapunovEstimate parse_lyapunov_estimate(const std::string& name);
 // nearby trajectories for one without.
 LyapunovEstimate default_lyapunov_estimate(Method method);
 
+// Which verdicts of an approximate fixed-grid method (the PIM at its step) are checked by the exact
+// event-driven solver: the PIM's O(η²) error can turn a stable period-4 orbit into a small chaotic
+// motion around it (measured on the (θ, α) map: α = 10, θ = 0.82, λ1 = +0.10 by the PIM at T/200,
+// a period-4 orbit with λ1 = −0.17 by the exact solver), or move a long period or a torus.
+enum class Confirmation {
+  none,       // the method's verdict stands
+  uncertain,  // a point still uncertain (after adaptive evidence and refinement) is run again
+  aperiodic,  // so are chaotic and quasi-periodic points
+};
+// "none", "uncertain", "aperiodic"; the inverse throws InputError naming the value.
+std::string confirmation_name(Confirmation confirmation);
+Confirmation parse_confirmation(const std::string& name);
+
 struct PointSettings {
   int transient_periods = 500;  // forcing periods integrated and discarded (>= 0)
   int recorded_periods = 500;   // Poincaré points recorded and classified (>= 1)
@@ -67,6 +80,27 @@ struct PointSettings {
   // 0-based state components kept in PointResult::poincare: 0..n-1 are x1..xn, n..2n-1 are
   // v1..vn. May be empty (a regime map keeps only the indicators).
   std::vector<int> components;
+  // Adaptive evidence: a record classified "uncertain" (its indicators disagree) is carried on,
+  // doubling it each time (500 recorded: 1000, 2000, 4000 in all), and classified again, until a
+  // verdict or until this many periods beyond recorded_periods are spent; 0 (the default): the
+  // record is what is set. PointResult::extra_periods says how many were used. Stroboscopic
+  // sections only. Refinement (below) runs after it, on the last record.
+  int evidence_periods = 0;
+  // Which verdicts the exact event-driven solver checks (see Confirmation): the point is run
+  // again from its initial state with the same settings but the exact solver, and that run's
+  // result is the point's (PointResult::confirmed_by says so). Only for a method that is not
+  // exact and a structure the exact solver takes (up to kRefinedMasses degrees of freedom); a
+  // confirming run that fails (the solver's work budget) leaves the method's verdict.
+  Confirmation confirm = Confirmation::none;
+  // Orbit refinement (orbits/orbit_refinement.hpp) of a motion classified "quasi-periodic" or
+  // "uncertain": Newton on the stroboscopic map from the motion's final state, at candidate
+  // periods up to this many forcing periods; 0 (the library's default) leaves the verdict to the
+  // record alone. When it finds a periodic orbit the motion is on, or an attracting one the
+  // motion is confirmed to approach, the point is "period-k" with the periods it still needs in
+  // PointResult::settle_periods. Structures of more than kRefinedMasses degrees of freedom are
+  // not refined (Newton carries 2n tangent columns through up to this many periods).
+  int refine_max_period = 0;
+  static constexpr int kRefinedMasses = 20;
   // How many of the recorded points are kept: 0 every one, N > 0 only the last N (the last N
   // periods of a stroboscopic section, the last N crossings of a hyperplane). All of them are
   // classified either way. A basin map matches attractors on a short tail of each cell's motion
@@ -102,6 +136,14 @@ struct PointResult {
   double lambda1 = std::numeric_limits<double>::quiet_NaN();  // per forcing period; NaN: none
   double lambda1_error = std::numeric_limits<double>::quiet_NaN();
   double K = std::numeric_limits<double>::quiet_NaN();  // 0-1 test; NaN when not computed
+  // Set when orbit refinement settled the regime (PointSettings::refine_max_period): the forcing
+  // periods the motion still needs to come within 1e-8 of the orbit, 0 when it is on it; NaN
+  // when the regime is the record's own.
+  double settle_periods = std::numeric_limits<double>::quiet_NaN();
+  // Adaptive evidence (PointSettings::evidence_periods): the periods recorded beyond the setting.
+  int extra_periods = 0;
+  // "exact" when the exact solver's run decided the point (PointSettings::confirm), else empty.
+  std::string confirmed_by;
 
   int columns = 0;              // = settings.components.size()
   std::vector<double> poincare; // recorded points x columns, row-major
