@@ -46,3 +46,16 @@ set cblabel 'λ1'
 unset key
 plot data using 3:4:(dx/2.0):(dy/2.0):(strcol(8) eq '' ? NaN : $8) with boxxyerror fs solid 1.0 \
        noborder lc palette
+# With --starts N: a third figure, the number of coexisting attractors reached from each cell's
+# starts (column 'attractors' of map.csv).
+if (exists("out_attractors")) {
+  set output out_attractors
+  set title 'coexisting attractors reached from each cell''s starts'.(subtitle eq '' ? '' : "\n{/*0.8 ".subtitle."}")
+  set palette defined (1 '#f7fbff', 2 '#6baed6', 3 '#2171b5', 4 '#08306b')
+  stats data using (column('attractors')) nooutput
+  set cbrange [1 : (STATS_max > 1 ? STATS_max : 2)]
+  set cbtics 1
+  set cblabel 'attractors'
+  plot data using 3:4:(dx/2.0):(dy/2.0):(column('attractors')) with boxxyerror fs solid 1.0 \
+         noborder lc palette
+}

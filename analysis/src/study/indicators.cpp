@@ -38,7 +38,7 @@ IndicatorValue get_code(const PointResult& r) {
 }
 
 // The table. Append new rows at the end: the result files' existing columns keep their places.
-constexpr std::array<Indicator, 9> kIndicators{{
+constexpr std::array<Indicator, 10> kIndicators{{
     {"regime", "the classified motion: period-k, quasi-periodic, chaotic, unbounded, uncertain",
      IndicatorType::text, false, "failed", get_regime, set_regime},
     {"code", "the regime as a small integer for colour maps (regime_code)", IndicatorType::integer,
@@ -65,6 +65,10 @@ constexpr std::array<Indicator, 9> kIndicators{{
      "the method whose run decided the point when an approximate method's verdict was checked "
      "(exact); empty otherwise",
      IndicatorType::text, false, "", get_confirmed_by, set_confirmed_by},
+    {"attractors",
+     "coexisting attractors reached from the point's starts (--starts > 1); 0 when not counted",
+     IndicatorType::integer, false, "", get_integer<&PointResult::attractors>,
+     set_integer<&PointResult::attractors>},
 }};
 
 std::string cell(const Indicator& indicator, const PointResult& r) {

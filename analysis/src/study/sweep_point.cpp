@@ -4,9 +4,11 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cmath>
 #include <memory>
 
+#include "pwl/analysis/attractor_catalogue.hpp"
 #include "pwl/analysis/lyapunov.hpp"
 #include "pwl/analysis/zero_one_test.hpp"
 #include "pwl/errors.hpp"
@@ -59,6 +61,10 @@ bool PointSettings::is_valid(int dofs, std::string* why) const {
   if (row.fixed_grid && steps_per_period < 1) {
     *why = fmt::format("steps per period = {} must be >= 1 ({} steps on a fixed grid)",
                        steps_per_period, row.name);
+    return false;
+  }
+  if (starts < 1 || starts > 1000) {
+    *why = fmt::format("starts = {} must be in 1..1000", starts);
     return false;
   }
   if (evidence_periods < 0) {
@@ -124,6 +130,7 @@ std::string PointSettings::describe() const {
   if (refine_max_period != 0) s += fmt::format("refine_max_period = {}\n", refine_max_period);
   if (evidence_periods != 0) s += fmt::format("evidence_periods = {}\n", evidence_periods);
   if (confirm != Confirmation::none) s += fmt::format("confirm = {}\n", confirmation_name(confirm));
+  if (starts != 1) s += fmt::format("starts = {}\n", starts);
   return s;
 }
 
@@ -239,8 +246,12 @@ void refine_regime(const PointCase& point, const PointSettings& s, const std::ve
 }
 
 // One evaluation with the settings' method: the record, adaptive evidence and refinement.
+// `tail`, when given, gets the last stroboscopic states (full [x; v]) the verdict rests on, at
+// most kTailPoints (empty for a motion that blew up or failed).
+constexpr std::size_t kTailPoints = 64;
 PointResult evaluate_record(const PointCase& point, const Vector& initial_state,
-                            const PointSettings& s, PointObserver* observer) {
+                            const PointSettings& s, PointObserver* observer,
+                            std::vector<Vector>* tail = nullptr) {
   const GapStructure& structure = point.structure;
   const Index n = structure.dofs();
   std::string why;
@@ -438,6 +449,10 @@ PointResult evaluate_record(const PointCase& point, const Vector& initial_state,
   result.period = c.regime == Regime::periodic ? c.period : 0;
   if (c.regime == Regime::unbounded || !result.final_state.allFinite()) result.final_state.resize(0);
   refine_regime(point, s, points, result);
+  if (tail != nullptr && result.final_state.size() != 0) {
+    const std::size_t from = points.size() - std::min(points.size(), kTailPoints);
+    tail->assign(points.begin() + static_cast<std::ptrdiff_t>(from), points.end());
+  }
   if (observer != nullptr) observer->classified(c, result);
   return result;
 }
@@ -475,9 +490,13 @@ Confirmation parse_confirmation(const std::string& name) {
   throw InputError(fmt::format("confirmation '{}': expected none, uncertain or aperiodic", name));
 }
 
-PointResult evaluate_point(const PointCase& point, const Vector& initial_state,
-                           const PointSettings& s, PointObserver* observer) {
-  PointResult result = evaluate_record(point, initial_state, s, observer);
+namespace {
+
+// The record, then the exact solver's run when the verdict asks for it (PointSettings::confirm).
+PointResult evaluate_confirmed(const PointCase& point, const Vector& initial_state,
+                               const PointSettings& s, PointObserver* observer,
+                               std::vector<Vector>* tail) {
+  PointResult result = evaluate_record(point, initial_state, s, observer, tail);
   const Index n = point.structure.dofs();
   if (!needs_confirmation(s, result) || s.method.method == Method::exact ||
       n > PointSettings::kRefinedMasses) {
@@ -488,10 +507,76 @@ PointResult evaluate_point(const PointCase& point, const Vector& initial_state,
   exact.confirm = Confirmation::none;
   std::string why;
   if (!exact.method_for(point.period).is_valid(point.structure, &why)) return result;
-  PointResult confirmed = evaluate_record(point, initial_state, exact, observer);
+  std::vector<Vector> exact_tail;
+  PointResult confirmed =
+      evaluate_record(point, initial_state, exact, observer, tail ? &exact_tail : nullptr);
   if (confirmed.regime == "failed") return result;
   confirmed.confirmed_by = "exact";
+  if (tail != nullptr) *tail = std::move(exact_tail);
   return confirmed;
+}
+
+// A reproducible uniform number in [-1, 1] for start m, component c (splitmix64 of both; no
+// generator state, so that every point and thread draws the same starts).
+double start_coordinate(int m, Index c) {
+  std::uint64_t z = 0x9e3779b97f4a7c15ULL * (static_cast<std::uint64_t>(m) * 1000003ULL +
+                                            static_cast<std::uint64_t>(c) + 1ULL);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  z ^= z >> 31;
+  return 2.0 * (static_cast<double>(z >> 11) * 0x1.0p-53) - 1.0;
+}
+
+Matrix as_rows(const std::vector<Vector>& states) {
+  Matrix m(static_cast<Index>(states.size()), states.empty() ? 0 : states.front().size());
+  for (std::size_t i = 0; i < states.size(); ++i) m.row(static_cast<Index>(i)) = states[i];
+  return m;
+}
+
+}  // namespace
+
+PointResult evaluate_point(const PointCase& point, const Vector& initial_state,
+                           const PointSettings& s, PointObserver* observer) {
+  if (s.starts <= 1) return evaluate_confirmed(point, initial_state, s, observer, nullptr);
+  std::vector<Vector> tail;
+  PointResult result = evaluate_confirmed(point, initial_state, s, observer, &tail);
+  // Coexisting attractors: starts − 1 more initial states in boxes about the motion that grow
+  // from 1.5 to 6 times the largest |x| and |v| of its tail (1 when it has none), so that basins
+  // near the motion and far from it are both sampled; each is classified the same way and
+  // matched to the attractors found so far (attractor_catalogue.hpp).
+  const Index n = point.structure.dofs();
+  double x_scale = 0.0, v_scale = 0.0;
+  for (const Vector& y : tail) {
+    x_scale = std::max(x_scale, y.head(n).cwiseAbs().maxCoeff());
+    v_scale = std::max(v_scale, y.tail(n).cwiseAbs().maxCoeff());
+  }
+  x_scale = x_scale > 0.0 ? 1.5 * x_scale : 1.0;
+  v_scale = v_scale > 0.0 ? 1.5 * v_scale : 1.0;
+  AttractorCatalogue catalogue;
+  const auto match = [&](const PointResult& r, const std::vector<Vector>& t) {
+    if (r.regime == "failed") return;
+    if (r.regime != "unbounded" && t.size() < static_cast<std::size_t>(std::max(2, r.period))) return;
+    catalogue.match({r.regime, r.period, as_rows(t)});
+  };
+  match(result, tail);
+  PointSettings other = s;
+  other.starts = 1;
+  other.components.clear();
+  other.kept_points = 0;
+  for (int m = 1; m < s.starts; ++m) {
+    const double grow =
+        s.starts > 2 ? 1.0 + 3.0 * static_cast<double>(m - 1) / static_cast<double>(s.starts - 2)
+                     : 1.0;
+    Vector start(2 * n);
+    for (Index c = 0; c < 2 * n; ++c) {
+      start[c] = grow * (c < n ? x_scale : v_scale) * start_coordinate(m, c);
+    }
+    std::vector<Vector> other_tail;
+    const PointResult r = evaluate_confirmed(point, start, other, observer, &other_tail);
+    match(r, other_tail);
+  }
+  result.attractors = static_cast<int>(catalogue.attractors().size());
+  return result;
 }
 
 }  // namespace pwl::analysis

@@ -36,8 +36,9 @@ void basin(const BasinFlags& f) {
     const analysis::BasinMap basins = analysis::match_basins(o, records);
     analysis::write_basin_files(o, records, basins, f.run.out);
     fmt::print("wrote {0}/basin.csv ({1} cells), {0}/attractors.csv and {0}/attractor_points.csv "
-               "({2} attractors)\n",
-               f.run.out, records.size(), basins.attractors.size());
+               "({2} attractor{3})\n",
+               f.run.out, records.size(), basins.attractors.size(),
+               basins.attractors.size() == 1 ? "" : "s");
     for (const analysis::Attractor& a : basins.attractors) {
       fmt::print("  attractor {}: {}, {} cells ({:.1f}%)\n", a.id, a.name(), a.motions,
                  100.0 * static_cast<double>(a.motions) / static_cast<double>(records.size()));
@@ -111,6 +112,11 @@ analysis::BasinMapOptions basin_options(const BasinFlags& f) {
   if (o.first.component == o.second.component) {
     throw InputError(fmt::format("--x {} and --y {}: give two different state components", f.x,
                                  f.y));
+  }
+  if (f.point.starts != 1) {
+    throw InputError(fmt::format("--starts {}: a basin map starts every cell from its own state "
+                                 "(the grid); give 1",
+                                 f.point.starts));
   }
   o.point = f.point.settings(dofs);
   o.point.kept_points = f.kept_points;

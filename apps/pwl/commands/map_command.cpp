@@ -31,12 +31,16 @@ void map(const MapFlags& f) {
     const auto definitions = [&](const std::string& format) {
       return fmt::format(
           "data='{0}/map.csv'; out='{0}/regime_map.{6}'; out_lambda='{0}/lambda1_map.{6}'; "
-          "xname='{1}'; yname='{2}'; dx={3:.17g}; dy={4:.17g}; subtitle={5}",
+          "xname='{1}'; yname='{2}'; dx={3:.17g}; dy={4:.17g}; subtitle={5}{7}",
           f.run.out, parameter_label(o.first.parameter), parameter_label(o.second.parameter), dx,
-          dy, gnuplot_quoted(study_title(o.model(), o.point)), format);
+          dy, gnuplot_quoted(study_title(o.model(), o.point)), format,
+          o.point.starts > 1
+              ? fmt::format("; out_attractors='{}/attractors_map.{}'", f.run.out, format)
+              : std::string());
     };
     if (draw_figure(scripts_directory() + "/regime_map.gp", definitions, &why)) {
-      fmt::print("wrote {0}/regime_map.png, {0}/lambda1_map.png and their .svg\n", f.run.out);
+      fmt::print("wrote {0}/regime_map.png, {0}/lambda1_map.png{1} and their .svg\n", f.run.out,
+                 o.point.starts > 1 ? fmt::format(", {}/attractors_map.png", f.run.out) : "");
     } else {
       fmt::print(stderr, "pwl map: no figure: {}\n", why);
     }

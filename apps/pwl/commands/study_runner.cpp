@@ -93,6 +93,7 @@ analysis::PointSettings PointFlags::settings(int masses) const {
   s.refine_max_period = refine_orbits;
   s.evidence_periods = evidence_periods;
   s.confirm = analysis::parse_confirmation(confirm);
+  s.starts = starts;
   for (const std::string& name : record) s.components.push_back(parse_component("--record", name, masses));
   if (record.empty()) s.components = {masses - 1, 2 * masses - 1};
   std::string why;
@@ -139,6 +140,11 @@ void add_point_flags(CLI::App& c, PointFlags& f, bool with_record) {
                "running the point again (up to 20 masses): none (default), uncertain, or aperiodic\n"
                "(uncertain, chaotic and quasi-periodic); confirmed_by says which did")
       ->check(CLI::IsMember({"none", "uncertain", "aperiodic"}));
+  c.add_option("--starts", f.starts,
+               "Coexisting attractors: start each point from this many initial states (its own and\n"
+               "reproducible random ones about its motion) and count the distinct attractors they\n"
+               "reach (column attractors); the point's other columns stay its own start's")
+      ->check(number_in(1, 1000));
 }
 
 void add_run_flags(CLI::App& c, RunFlags& f) {

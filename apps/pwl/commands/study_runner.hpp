@@ -71,6 +71,7 @@ struct PointFlags {
   int refine_orbits = 0;  // longest candidate period of orbit refinement; 0: none
   int evidence_periods = 0;  // adaptive evidence budget; 0: none
   std::string confirm = "none";  // verdicts the exact solver checks: none, uncertain, aperiodic
+  int starts = 1;  // initial states per point, for counting coexisting attractors
   // Throws InputError for a bad name or value.
   analysis::PointSettings settings(int dofs) const;
 };

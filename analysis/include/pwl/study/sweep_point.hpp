@@ -86,6 +86,13 @@ struct PointSettings {
   // record is what is set. PointResult::extra_periods says how many were used. Stroboscopic
   // sections only. Refinement (below) runs after it, on the last record.
   int evidence_periods = 0;
+  // Coexisting attractors: besides `initial_state` the point is started from starts − 1 more
+  // states, reproducible pseudo-random ones in boxes about the motion that grow from 1.5 to 6
+  // times the largest |x| and |v| over the tail of the first motion, each evaluated with these
+  // settings, and
+  // PointResult::attractors counts the distinct attractors they end on (attractor_catalogue.hpp).
+  // The point's own indicators stay those of the first start. 1: not counted.
+  int starts = 1;
   // Which verdicts the exact event-driven solver checks (see Confirmation): the point is run
   // again from its initial state with the same settings but the exact solver, and that run's
   // result is the point's (PointResult::confirmed_by says so). Only for a method that is not
@@ -144,6 +151,9 @@ struct PointResult {
   int extra_periods = 0;
   // "exact" when the exact solver's run decided the point (PointSettings::confirm), else empty.
   std::string confirmed_by;
+  // Distinct attractors reached from the point's starts (PointSettings::starts > 1, the
+  // attractor at infinity counted); 0 when not counted.
+  int attractors = 0;
 
   int columns = 0;              // = settings.components.size()
   std::vector<double> poincare; // recorded points x columns, row-major
