@@ -18,6 +18,7 @@
 #include "pwl/errors.hpp"
 #include "pwl/integrators/method_table.hpp"
 #include "pwl/integrators/step_guard.hpp"
+#include "orbit_cases.hpp"
 #include "pwl/model/chain_builders.hpp"
 #include "test_structures.hpp"
 
@@ -295,13 +296,7 @@ TEST_CASE("the step guard accepts the paper's settings and every shipped scene's
   for (Case& c : theta_range(15.0)) scenes["theta_alpha_map"].push_back(std::move(c));
   {
     // The hardening oscillator of the basin scene: one mass, α = 3, θ = 1.2, η = T/200.
-    NondimensionalChain hardening;
-    hardening.masses = 1;
-    hardening.alpha = {3.0};
-    hardening.zeta = 0.1;
-    hardening.gap = {1.5};
-    hardening.amplitude = {0.5};
-    hardening.theta = 1.2;
+    const NondimensionalChain hardening = pwl::test::hardening_oscillator(1.2);
     scenes["hardening_basins"] = {Case{make_chain(hardening),
                                        fixed_step(Method::pim, hardening.period() / 200),
                                        hardening.period()}};

@@ -123,12 +123,7 @@ TEST_CASE("a basin map does not depend on the number of threads", "[basin_map]")
 
 TEST_CASE("the undamped resonance is unbounded from every initial state", "[basin_map]") {
   BasinMapOptions o;
-  o.chain.masses = 1;
-  o.chain.alpha = {0.0};
-  o.chain.zeta = 0.0;
-  o.chain.gap = {0.0};
-  o.chain.amplitude = {1.0};
-  o.chain.theta = 1.0;
+  o.chain = pwl::test::undamped_resonance();
   o.first = {0, -1.0, 1.0, 3};
   o.second = {1, -1.0, 1.0, 3};
   o.point.transient_periods = 100;

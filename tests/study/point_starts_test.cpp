@@ -65,13 +65,7 @@ TEST_CASE("two attractors inside the hysteresis of the hardening oscillator, one
 }
 
 TEST_CASE("the undamped resonance reaches only the attractor at infinity", "[sweep_point][starts]") {
-  NondimensionalChain c;
-  c.masses = 1;
-  c.alpha = {0.0};
-  c.zeta = 0.0;
-  c.gap = {0.0};
-  c.amplitude = {1.0};
-  c.theta = 1.0;
+  const NondimensionalChain c = pwl::test::undamped_resonance();
   PointSettings s = with_starts(4);
   s.transient_periods = 100;
   s.recorded_periods = 200;

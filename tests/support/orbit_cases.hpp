@@ -48,6 +48,19 @@ inline NondimensionalChain hardening_oscillator(double theta) {
   return c;
 }
 
+// The undamped linear resonance of the chain's one mass (α = 0, ζ = 0, Q = 1, θ = 1): its amplitude
+// grows like t from every initial state.
+inline NondimensionalChain undamped_resonance() {
+  NondimensionalChain c;
+  c.masses = 1;
+  c.alpha = {0.0};
+  c.zeta = 0.0;
+  c.gap = {0.0};
+  c.amplitude = {1.0};
+  c.theta = 1.0;
+  return c;
+}
+
 // x'' + 2ζ x' + x + α max(0, x − Δ) = q sin(θ t): one unit mass, one gap spring to the ground.
 struct GapOscillator {
   double zeta = 0.05;

@@ -12,10 +12,7 @@
 
 namespace pwl::analysis {
 
-double StateAxis::value(int index) const {
-  if (points == 1) return from;
-  return from + (to - from) * static_cast<double>(index) / static_cast<double>(points - 1);
-}
+double StateAxis::value(int index) const { return grid_value(from, to, points, index); }
 
 BasinMapOptions::BasinMapOptions() { point.kept_points = 64; }
 

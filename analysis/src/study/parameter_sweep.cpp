@@ -70,10 +70,7 @@ bool SweepOptions::is_valid(std::string* why) const {
   return true;
 }
 
-double SweepOptions::value(int index) const {
-  if (points == 1) return from;
-  return from + (to - from) * static_cast<double>(index) / static_cast<double>(points - 1);
-}
+double SweepOptions::value(int index) const { return grid_value(from, to, points, index); }
 
 std::vector<GridTask> SweepOptions::tasks() const {
   std::vector<GridTask> result;

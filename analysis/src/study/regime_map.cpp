@@ -10,10 +10,7 @@
 
 namespace pwl::analysis {
 
-double MapAxis::value(int index) const {
-  if (points == 1) return from;
-  return from + (to - from) * static_cast<double>(index) / static_cast<double>(points - 1);
-}
+double MapAxis::value(int index) const { return grid_value(from, to, points, index); }
 
 namespace {
 

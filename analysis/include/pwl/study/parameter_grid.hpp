@@ -20,6 +20,13 @@
 
 namespace pwl::analysis {
 
+// Value `index` of `points` evenly spaced values from `from` to `to` (just `from` when points is
+// 1): the grid of every sweep, map and basin axis, computed one way so that they agree to the bit.
+inline double grid_value(double from, double to, int points, int index) {
+  if (points == 1) return from;
+  return from + (to - from) * static_cast<double>(index) / static_cast<double>(points - 1);
+}
+
 struct GridTask {
   std::vector<long> ids;      // in the order they are computed
   bool continuation = false;  // each point starts from the previous point's final state
