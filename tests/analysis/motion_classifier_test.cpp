@@ -8,7 +8,9 @@
 #include <numbers>
 
 #include "pwl/analysis/lyapunov.hpp"
+#include "pwl/analysis/weighted_birkhoff.hpp"
 #include "pwl/errors.hpp"
+#include "study_cases.hpp"
 #include "test_series.hpp"
 
 using pwl::Matrix;
@@ -259,6 +261,63 @@ TEST_CASE("disagreeing indicators give uncertain, not a guess", "[classifier]") 
     const Classification found = classify_motion(long_cycle, evidence, options);
     CHECK(found.regime == Regime::periodic);
     CHECK(found.period == 100);
+  }
+}
+
+TEST_CASE("the torus test vetoes chaos on a curve and settles inconclusive indicators on one",
+          "[classifier][torus]") {
+  // The golden rotation's points lie on a smooth closed curve: the torus test scores many digits
+  // on them (weighted_birkhoff_test.cpp), and the Hénon attractor's only about 2.
+  const std::vector<Vector> curve = orbit(conjugated_golden_rotation(), point(1.0, 0.0), 2000);
+  const double curve_digits = weighted_birkhoff_test(pwl::test::as_rows(curve)).digits;
+  CHECK(curve_digits > 8.0);
+  const std::vector<Vector> henon_points = orbit(henon(), point(0.1, 0.1), 2000);
+  const double henon_digits = weighted_birkhoff_test(pwl::test::as_rows(henon_points)).digits;
+  CHECK(henon_digits < 2.5);
+
+  SECTION("λ1 > 0 and K chaotic on a curve: uncertain, not chaotic") {
+    MotionEvidence evidence;
+    evidence.lyapunov = 0.1;
+    evidence.lyapunov_error = 0.01;
+    evidence.zero_one_K = 0.9;
+    CHECK(classify_motion(curve, evidence).regime == Regime::chaotic);  // without the test
+    evidence.torus_digits = curve_digits;
+    const Classification c = classify_motion(curve, evidence);
+    CHECK(c.regime == Regime::uncertain);
+    CHECK_THAT(c.reason, Contains("smooth invariant curve") && Contains("torus test"));
+    // A failed torus test does not stand in the way of chaos.
+    MotionEvidence chaos = evidence;
+    chaos.torus_digits = henon_digits;
+    CHECK(classify_motion(henon_points, chaos).regime == Regime::chaotic);
+  }
+  SECTION("an inconclusive λ1 holding 0 and K in between: quasi-periodic on a curve only") {
+    MotionEvidence evidence;
+    evidence.lyapunov = 0.004;
+    evidence.lyapunov_error = 0.01;
+    evidence.zero_one_K = 0.5;
+    CHECK(classify_motion(curve, evidence).regime == Regime::uncertain);
+    evidence.torus_digits = curve_digits;
+    CHECK(classify_motion(curve, evidence).regime == Regime::quasi_periodic);
+    evidence.torus_digits = 3.0;  // between broken (2.5) and curve (5): no help
+    CHECK(classify_motion(curve, evidence).regime == Regime::uncertain);
+  }
+  SECTION("a λ1 whose error bar excludes 0 is not settled by the curve") {
+    MotionEvidence evidence;
+    evidence.lyapunov = -0.008;  // inconclusive against the margin, but below 0: a long period
+    evidence.lyapunov_error = 0.005;
+    evidence.zero_one_K = 0.1;
+    evidence.torus_digits = curve_digits;
+    CHECK(classify_motion(curve, evidence).regime == Regime::uncertain);
+  }
+  SECTION("bad torus digits and thresholds are named") {
+    MotionEvidence evidence;
+    evidence.torus_digits = -1.0;
+    CHECK_THROWS_WITH(classify_motion(curve, evidence), Contains("torus_digits = -1"));
+    ClassifierOptions options;
+    options.broken_digits = 6.0;
+    std::string why;
+    CHECK_FALSE(options.is_valid(&why));
+    CHECK_THAT(why, Contains("broken_digits = 6"));
   }
 }
 

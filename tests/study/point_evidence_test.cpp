@@ -11,6 +11,7 @@
 #include <cmath>
 
 #include "orbit_cases.hpp"
+#include "study_cases.hpp"
 #include "pwl/analysis/zero_one_test.hpp"
 #include "pwl/orbits/periodic_orbit.hpp"
 #include "pwl/orbits/stroboscopic_map.hpp"
@@ -23,10 +24,7 @@ namespace {
 
 // Cell (i, j) of apps/scenes/theta_alpha_map.toml: θ = 0.5 + 2.5 i / 39, α = 1 + 0.5 j.
 NondimensionalChain map_cell(int i, int j) {
-  NondimensionalChain c = paper_five_dof_case("5");
-  c.theta = 0.5 + 2.5 * i / 39.0;
-  c.alpha = {1.0 + 0.5 * j};
-  return c;
+  return pwl::test::figure5_cell(1.0 + 0.5 * j, 0.5 + 2.5 * i / 39.0);
 }
 
 PointSettings record(int transient, int recorded) {

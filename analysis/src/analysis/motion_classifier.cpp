@@ -19,6 +19,7 @@ bool fail(std::string* why, std::string message) {
 
 enum class Sign { positive, zero, negative, inconclusive, unknown };
 enum class ZeroOne { chaotic, regular, between, unknown };
+enum class Torus { curve, broken, between, unknown };
 
 Sign read_lyapunov(const Classification& c, double margin) {
   if (!c.lyapunov) return Sign::unknown;
@@ -37,6 +38,44 @@ ZeroOne read_zero_one(const std::optional<double>& K, const ClassifierOptions& o
   return ZeroOne::between;
 }
 
+Torus read_torus(const std::optional<double>& digits, const ClassifierOptions& options) {
+  if (!digits) return Torus::unknown;
+  if (*digits >= options.curve_digits) return Torus::curve;
+  if (*digits < options.broken_digits) return Torus::broken;
+  return Torus::between;
+}
+
+const char* sign_word(Sign s) {
+  switch (s) {
+    case Sign::positive: return "positive";
+    case Sign::zero: return "zero";
+    case Sign::negative: return "negative";
+    case Sign::inconclusive: return "inconclusive";
+    case Sign::unknown: return "unknown";
+  }
+  return "unknown";
+}
+
+const char* zero_one_word(ZeroOne z) {
+  switch (z) {
+    case ZeroOne::chaotic: return "chaotic";
+    case ZeroOne::regular: return "regular";
+    case ZeroOne::between: return "between";
+    case ZeroOne::unknown: return "unknown";
+  }
+  return "unknown";
+}
+
+const char* torus_word(Torus t) {
+  switch (t) {
+    case Torus::curve: return "curve";
+    case Torus::broken: return "broken";
+    case Torus::between: return "between";
+    case Torus::unknown: return "unknown";
+  }
+  return "unknown";
+}
+
 std::string describe(const Classification& c) {
   std::string text;
   if (c.lyapunov) {
@@ -49,6 +88,7 @@ std::string describe(const Classification& c) {
   } else {
     text += ", K unknown";
   }
+  if (c.torus_digits) text += fmt::format(", torus test {:.2f} digits", *c.torus_digits);
   return text;
 }
 
@@ -155,6 +195,11 @@ void check_evidence(const MotionEvidence& evidence) {
     throw InputError(fmt::format("MotionEvidence.zero_one_K = {} must be finite and in [-1, 1]",
                                  *evidence.zero_one_K));
   }
+  if (evidence.torus_digits &&
+      !(std::isfinite(*evidence.torus_digits) && *evidence.torus_digits >= 0.0)) {
+    throw InputError(fmt::format("MotionEvidence.torus_digits = {} must be finite and >= 0",
+                                 *evidence.torus_digits));
+  }
   if (!(evidence.first_point_time > 0.0) || !std::isfinite(evidence.first_point_time)) {
     throw InputError(fmt::format("MotionEvidence.first_point_time = {} must be finite and > 0",
                                  evidence.first_point_time));
@@ -193,6 +238,11 @@ bool ClassifierOptions::is_valid(std::string* why) const {
                                  "0 < regular_K <= chaotic_K < 1",
                                  regular_K, chaotic_K));
   }
+  if (!(broken_digits > 0.0 && broken_digits <= curve_digits && curve_digits <= 15.0)) {
+    return fail(why, fmt::format("ClassifierOptions.broken_digits = {}, curve_digits = {}: need "
+                                 "0 < broken_digits <= curve_digits <= 15",
+                                 broken_digits, curve_digits));
+  }
   if (!(divergence_bound > 0.0)) {
     return fail(why, fmt::format("ClassifierOptions.divergence_bound = {} must be > 0",
                                  divergence_bound));
@@ -226,6 +276,7 @@ Classification classify_motion(const std::vector<Vector>& points, const MotionEv
     c.zero_one_K = evidence.zero_one_K;
     c.zero_one_source = "given";
   }
+  c.torus_digits = evidence.torus_digits;
 
   // Rule 1.
   std::string where;
@@ -247,6 +298,7 @@ Classification classify_motion(const std::vector<Vector>& points, const MotionEv
       c.regime = Regime::uncertain;
       c.reason = fmt::format("uncertain: {} but λ1 = {:.4g} ± {:.2g} is clearly positive", found,
                              *c.lyapunov, c.lyapunov_error);
+      c.readings = fmt::format("period:{};lambda1:positive", k);
       return c;
     }
     if (k == 1 && options.fixed_point_is_equilibrium) {
@@ -266,6 +318,7 @@ Classification classify_motion(const std::vector<Vector>& points, const MotionEv
     c.regime = Regime::uncertain;
     c.reason = fmt::format("uncertain: {} points are too few to test any period (need {})",
                            points.size(), options.period.cycles + 1);
+    c.readings = "points:too-few";
     return c;
   }
 
@@ -311,14 +364,24 @@ Classification classify_motion(const std::vector<Vector>& points, const MotionEv
                   c.period_search.best_k, c.period_search.mismatch, describe(c));
   const bool lenient = !options.require_all_indicators;
 
-  if ((lyapunov == Sign::positive && zero_one == ZeroOne::chaotic) ||
-      (lenient && lyapunov == Sign::positive && zero_one == ZeroOne::unknown) ||
-      (lenient && lyapunov == Sign::unknown && zero_one == ZeroOne::chaotic)) {
+  const Torus torus = read_torus(c.torus_digits, options);
+  // A smooth invariant curve contradicts chaos.
+  if (torus != Torus::curve &&
+      ((lyapunov == Sign::positive && zero_one == ZeroOne::chaotic) ||
+       (lenient && lyapunov == Sign::positive && zero_one == ZeroOne::unknown) ||
+       (lenient && lyapunov == Sign::unknown && zero_one == ZeroOne::chaotic))) {
     c.regime = Regime::chaotic;
     c.reason = "chaotic: " + numbers;
     return c;
   }
+  // A smooth invariant curve settles a λ1 whose error bar straddles the margin but holds 0, or a
+  // K in between, when neither reads chaos. A λ1 whose error bar excludes 0 (below it: a long
+  // period approached slowly; above it) is left to more evidence.
+  const bool holds_zero = c.lyapunov && std::abs(*c.lyapunov) <= c.lyapunov_error;
   if ((lyapunov == Sign::zero && zero_one == ZeroOne::regular) ||
+      (torus == Torus::curve &&
+       (lyapunov == Sign::zero || (lyapunov == Sign::inconclusive && holds_zero)) &&
+       (zero_one == ZeroOne::regular || zero_one == ZeroOne::between)) ||
       (lenient && lyapunov == Sign::zero && zero_one == ZeroOne::unknown) ||
       (lenient && lyapunov == Sign::unknown && zero_one == ZeroOne::regular)) {
     c.regime = Regime::quasi_periodic;
@@ -326,9 +389,13 @@ Classification classify_motion(const std::vector<Vector>& points, const MotionEv
     return c;
   }
   c.regime = Regime::uncertain;
+  c.readings = fmt::format("period:none;lambda1:{};K:{};torus:{}", sign_word(lyapunov),
+                           zero_one_word(zero_one), torus_word(torus));
   if (lyapunov == Sign::negative && zero_one != ZeroOne::chaotic) {
     c.reason = "uncertain: λ1 < 0 but " + numbers +
                ": a period beyond k_max, or a transient not yet over";
+  } else if (torus == Torus::curve && lyapunov == Sign::positive) {
+    c.reason = "uncertain: the points lie on a smooth invariant curve but λ1 > 0: " + numbers;
   } else if (lyapunov == Sign::unknown && zero_one == ZeroOne::unknown) {
     c.reason = "uncertain: " + numbers + ": no indicator beyond the period search";
   } else {

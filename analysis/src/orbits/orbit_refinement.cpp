@@ -32,6 +32,12 @@ bool RefinementOptions::is_valid(std::string* why) const {
     *why = fmt::format("on-orbit tolerance = {} must be positive and finite", on_orbit_tolerance);
     return false;
   }
+  for (int k : periods) {
+    if (k < 1 || k > max_period) {
+      *why = fmt::format("period {} to try must be in 1..max period = {}", k, max_period);
+      return false;
+    }
+  }
   ShootingOptions shooting_check = shooting;
   shooting_check.period = 1;
   return shooting_check.is_valid(why);
@@ -149,7 +155,11 @@ void assess(StroboscopicMap& map, const Vector& last_state, const RefinementOpti
       if (i > r.check_periods - window) last = std::max(last, d);
     }
     r.measured_factor = last / first;
-    r.approach_confirmed = r.measured_factor <= std::sqrt(r.predicted_factor);
+    // Only an approach that halves within the check can be confirmed: a slower one (a leading
+    // multiplier so close to the unit circle that the budget holds less than a halving) predicts a
+    // change the rise and fall of a motion on a torus around the orbit can mimic.
+    r.approach_confirmed = r.predicted_factor <= 0.5 &&
+                           r.measured_factor <= std::sqrt(r.predicted_factor);
   } catch (const DivergenceError&) {
     r.approach_confirmed = false;
   }
@@ -169,7 +179,9 @@ OrbitRefinement refine_orbit(StroboscopicMap& map, const std::vector<Vector>& po
 
   // Every candidate in turn until an orbit explains the motion; otherwise the first orbit found.
   OrbitRefinement r, first;
-  const std::vector<int> periods = candidate_periods(points, options.max_period, options.candidates);
+  const std::vector<int> periods =
+      options.periods.empty() ? candidate_periods(points, options.max_period, options.candidates)
+                              : options.periods;
   for (int k : periods) {
     r.tried.push_back(k);
     ShootingOptions shooting = options.shooting;

@@ -30,6 +30,10 @@ void set_integer(PointResult& r, const IndicatorValue& v) {
 IndicatorValue get_regime(const PointResult& r) { return r.regime; }
 void set_regime(PointResult& r, const IndicatorValue& v) { r.regime = std::get<std::string>(v); }
 IndicatorValue get_confirmed_by(const PointResult& r) { return r.confirmed_by; }
+IndicatorValue get_disagreement(const PointResult& r) { return r.disagreement; }
+void set_disagreement(PointResult& r, const IndicatorValue& v) {
+  r.disagreement = std::get<std::string>(v);
+}
 void set_confirmed_by(PointResult& r, const IndicatorValue& v) {
   r.confirmed_by = std::get<std::string>(v);
 }
@@ -38,7 +42,7 @@ IndicatorValue get_code(const PointResult& r) {
 }
 
 // The table. Append new rows at the end: the result files' existing columns keep their places.
-constexpr std::array<Indicator, 10> kIndicators{{
+constexpr std::array<Indicator, 14> kIndicators{{
     {"regime", "the classified motion: period-k, quasi-periodic, chaotic, unbounded, uncertain",
      IndicatorType::text, false, "failed", get_regime, set_regime},
     {"code", "the regime as a small integer for colour maps (regime_code)", IndicatorType::integer,
@@ -69,6 +73,25 @@ constexpr std::array<Indicator, 10> kIndicators{{
      "coexisting attractors reached from the point's starts (--starts > 1); 0 when not counted",
      IndicatorType::integer, false, "", get_integer<&PointResult::attractors>,
      set_integer<&PointResult::attractors>},
+    {"torus_digits",
+     "torus test of a record without a period: digits on which the weighted Birkhoff averages of "
+     "its halves agree (smooth invariant curve: high; chaos: 1 to 2)",
+     IndicatorType::real, false, "", get_real<&PointResult::torus_digits>,
+     set_real<&PointResult::torus_digits>},
+    {"rotation",
+     "rotation number of a record without a period in the (x1, x2) plane (x1, v1 for one mass), "
+     "turns per forcing period",
+     IndicatorType::real, false, "", get_real<&PointResult::rotation>,
+     set_real<&PointResult::rotation>},
+    {"chaotic_transient",
+     "transient chaos: forcing periods the motion wandered chaotically before it settled on its "
+     "period-k orbit; 0 when none was found",
+     IndicatorType::integer, false, "", get_integer<&PointResult::chaotic_transient>,
+     set_integer<&PointResult::chaotic_transient>},
+    {"disagreement",
+     "for an uncertain point, what each indicator read (period, lambda1, K, torus; or a period "
+     "Newton did not confirm), one token; empty otherwise",
+     IndicatorType::text, false, "", get_disagreement, set_disagreement},
 }};
 
 std::string cell(const Indicator& indicator, const PointResult& r) {

@@ -10,6 +10,7 @@
 
 #include "pwl/analysis/attractor_catalogue.hpp"
 #include "pwl/analysis/lyapunov.hpp"
+#include "pwl/analysis/weighted_birkhoff.hpp"
 #include "pwl/analysis/zero_one_test.hpp"
 #include "pwl/errors.hpp"
 #include "pwl/orbits/orbit_refinement.hpp"
@@ -205,6 +206,12 @@ void two_trajectory_lyapunov(const PointCase& point, const MethodSettings& metho
   }
 }
 
+Matrix as_rows(const std::vector<Vector>& states) {
+  Matrix m(static_cast<Index>(states.size()), states.empty() ? 0 : states.front().size());
+  for (std::size_t i = 0; i < states.size(); ++i) m.row(static_cast<Index>(i)) = states[i];
+  return m;
+}
+
 // Drops all but the last `kept` recorded points (0: keeps them all).
 void keep_last_points(int kept, PointResult& result) {
   if (kept <= 0) return;
@@ -220,29 +227,194 @@ void keep_last_points(int kept, PointResult& result) {
   }
 }
 
-// Orbit refinement of a quasi-periodic or uncertain record (PointSettings::refine_max_period):
-// the regime becomes period-k when Newton's orbit describes the motion (the motion is on it, or
-// confirmed to approach it). A failure of the refinement itself (an iterate that blows up, an
-// unsolvable LCP) leaves the record's verdict.
+// The period q of an orbit locked on a torus, from the rotation number of its points: the
+// denominator of the first continued-fraction convergent p/q of ρ with |ρ − p/q| <= kLocked / q²,
+// if q <= limit; 0 otherwise. Every irrational ρ has infinitely many p/q within 1/q² (Dirichlet),
+// and a typical one no p/q much closer, while an orbit locked at rotation p/q has that rotation to
+// the averages' precision (the (θ, α) map's cell α = 5, θ = 1.81 by the exact solver: ρ =
+// 0.3013698628 against 22/73 = 0.3013698630, 1e-6 of 1/q²). kLocked = 1e-3 asks a thousand times
+// closer than Dirichlet's bound: the torus at θ = 1.8, whose ρ = 0.3063343651 lies 6.6e-9 from
+// 295/963 (6e-3 of 1/q²), is not taken for a locked orbit.
+constexpr double kLocked = 1e-3;
+constexpr int kLockedPeriodLimit = 1000;
+int locked_period(double rho, int limit) {
+  if (!std::isfinite(rho)) return 0;
+  // Convergents h/k of ρ: h_{-1} = 1, h_{-2} = 0; k_{-1} = 0, k_{-2} = 1.
+  double x = rho;
+  long h0 = 0, h1 = 1, k0 = 1, k1 = 0;
+  for (int i = 0; i < 40; ++i) {
+    const double a = std::floor(x);
+    const long h = static_cast<long>(a) * h1 + h0;
+    const long k = static_cast<long>(a) * k1 + k0;
+    if (k > limit) return 0;
+    const double q = static_cast<double>(k);
+    if (k >= 1 && std::abs(rho - static_cast<double>(h) / q) <= kLocked / (q * q)) {
+      return static_cast<int>(k);
+    }
+    const double fraction = x - a;
+    if (fraction <= 0.0) return 0;
+    x = 1.0 / fraction;
+    h0 = h1;
+    h1 = h;
+    k0 = k1;
+    k1 = k;
+  }
+  return 0;
+}
+
+// Orbit refinement (PointSettings::refine_max_period). A quasi-periodic or uncertain record
+// becomes period-k when Newton's orbit describes the motion (the motion is on it, or confirmed to
+// approach it): first at the near-return candidates up to refine_max_period, then, for a record
+// whose rotation number is close to a fraction p/q (locked_period: an orbit locked on a torus,
+// beyond the period search), at q up to kLockedPeriodLimit. A long period the record's search found
+// (k > kCheckedPeriod, up to the search's limit of 64) is checked the same way at k: two cycles
+// that repeat to 1e-6 of the record's size can also be a slow near-return of a torus close to a
+// resonance, which Newton tells apart; a period Newton does not confirm is "uncertain". A failure
+// of the refinement itself (an iterate that blows up, an unsolvable LCP) leaves the record's
+// verdict.
+constexpr int kCheckedPeriod = 32;
 void refine_regime(const PointCase& point, const PointSettings& s, const std::vector<Vector>& points,
                    PointResult& result) {
   const Index n = point.structure.dofs();
   if (s.refine_max_period <= 0 || n > PointSettings::kRefinedMasses) return;
-  if (result.regime != "quasi-periodic" && result.regime != "uncertain") return;
+  const bool long_period = result.period > kCheckedPeriod;
+  if (result.regime != "quasi-periodic" && result.regime != "uncertain" && !long_period) return;
   if (result.final_state.size() != 2 * n) return;
   orbits::RefinementOptions options;
-  options.max_period = s.refine_max_period;
+  options.max_period = std::max(s.refine_max_period, result.period);
+  if (long_period) options.periods = {result.period};
   try {
     orbits::StroboscopicMap map(point, s.method, s.steps_per_period);
-    const orbits::OrbitRefinement r = orbits::refine_orbit(map, points, result.final_state, options);
-    if (!r.explains_motion()) return;
+    orbits::OrbitRefinement r = orbits::refine_orbit(map, points, result.final_state, options);
+    const int locked = long_period ? 0 : locked_period(result.rotation, kLockedPeriodLimit);
+    if (!r.explains_motion() && locked > 0 &&
+        std::find(r.tried.begin(), r.tried.end(), locked) == r.tried.end()) {
+      options.max_period = std::max(options.max_period, locked);
+      options.periods = {locked};
+      r = orbits::refine_orbit(map, points, result.final_state, options);
+    }
+    if (!r.explains_motion()) {
+      if (long_period) {
+        result.disagreement = fmt::format("period:{};newton:not-confirmed", result.period);
+        result.regime = regime_name(Regime::uncertain);
+        result.period = 0;
+      }
+      return;
+    }
     result.regime = regime_name(Regime::periodic, r.orbit.period);
     result.period = r.orbit.period;
+    result.disagreement.clear();
     result.settle_periods = r.on_orbit ? 0.0 : r.periods_to_settle;
   } catch (const DivergenceError&) {
   } catch (const LcpError&) {
   } catch (const BudgetError&) {
   }
+}
+
+// Transient chaos: a motion that ends on a period-k cycle may have wandered chaotically before.
+// `states` are the stroboscopic states from period 1 to the end, whose last k repeat. The motion
+// settled at period s + 1, s the last index farther from the cycle (the point of the cycle at the
+// same phase) than kSettledDistance of the region the whole motion visited (the diagonal of its
+// bounding box): before that it was far from the orbit. When s >= kChaoticTransient periods, the
+// finite-time λ1 of that stretch is measured along the motion itself (a companion started
+// kSeparation off each stored state for one period, its growth the stretch's one-period
+// factor, averaged as the record's λ1 is: lyapunov.hpp), K on the observable (also on every
+// k-th point, as for banded chaos) and the torus test on the states. A stretch whose λ1 is
+// clearly positive (λ1 − error > the classifier's margin, 0.005 per period), whose K is not
+// regular (>= 0.2) and whose states are not on a smooth curve (torus digits < 5, when it has 200
+// points or more) is a chaotic transient, and PointResult::chaotic_transient = s. Not K > 0.8:
+// a chaotic transient that ends on a period-k orbit has hovered near it, a banded chaos that
+// holds K down (measured on the (θ, α) map, α = 9, θ = 1.718: 3774 periods with λ1 = 0.059 ±
+// 0.005, K = 0.76, 3.0 digits, then a period-7 orbit). A companion
+// along the stored states, not a second trajectory from the start: chaos amplifies the rounding
+// of a re-run, whose own transient would end elsewhere.
+constexpr double kSettledDistance = 1e-2;
+constexpr int kChaoticTransient = 100;
+// The periods before the motion settled on its cycle, and whether they were chaotic.
+struct Settling {
+  std::size_t settled = 0;
+  bool chaotic = false;
+};
+Settling find_chaotic_transient(const PointCase& point, const MethodSettings& method, double phase,
+                                const std::vector<Vector>& states, int k, int observable) {
+  Settling out;
+  const std::size_t N = states.size();
+  if (k < 1 || N < static_cast<std::size_t>(kChaoticTransient + 2 * k)) return out;
+  Vector low = states.front(), high = states.front();
+  for (const Vector& y : states) {
+    low = low.cwiseMin(y);
+    high = high.cwiseMax(y);
+  }
+  const double far = kSettledDistance * (high - low).norm();
+  const std::size_t cycle = N - static_cast<std::size_t>(k);
+  std::size_t settled = 0;
+  for (std::size_t i = cycle; i-- > 0;) {
+    const std::size_t kk = static_cast<std::size_t>(k);
+    const std::size_t same = cycle + (i % kk + kk - cycle % kk) % kk;  // same phase on the cycle
+    if ((states[i] - states[same]).norm() > far) {
+      settled = i + 1;
+      break;
+    }
+  }
+  out.settled = settled;
+  if (settled < static_cast<std::size_t>(kChaoticTransient)) return out;
+  // λ1 along the stretch.
+  const Index n = point.structure.dofs();
+  auto companion = make_integrator(point.structure, method);
+  const double start = phase * point.period;
+  constexpr double kSeparation = 1e-7;
+  Vector direction = initial_tangent(2 * n).col(0);
+  std::vector<Matrix> growth;
+  growth.reserve(settled);
+  try {
+    for (std::size_t i = 0; i + 1 < settled; ++i) {
+      const Vector y = states[i] + kSeparation * direction;
+      companion->set_state(start, y.head(n), y.tail(n));
+      companion->advance_to(start + point.period);
+      Vector d(2 * n);
+      d << companion->position() - states[i + 1].head(n),
+          companion->velocity() - states[i + 1].tail(n);
+      const double norm = d.norm();
+      if (!(norm > 0.0) || !std::isfinite(norm)) return out;
+      growth.push_back(Matrix::Constant(1, 1, norm / kSeparation));
+      direction = d / norm;
+    }
+  } catch (const DivergenceError&) {
+    return out;
+  } catch (const LcpError&) {
+    return out;
+  } catch (const BudgetError&) {
+    return out;
+  }
+  LyapunovOptions l;
+  const Averaging a = averaging(static_cast<long>(growth.size()), static_cast<int>(growth.size()));
+  if (!a.enough()) return out;
+  l.transient = a.transient;
+  l.iterations = a.iterations;
+  l.blocks = a.blocks;
+  l.time_per_iteration = point.period;
+  const LyapunovResult lyapunov = lyapunov_spectrum(growth, l);
+  if (!(lyapunov.largest() - lyapunov.error[0] > ClassifierOptions{}.lyapunov_margin)) return out;
+  // K on the stretch, and on its every k-th point.
+  double K = -1.0;
+  for (std::size_t stride : {std::size_t{1}, static_cast<std::size_t>(k)}) {
+    std::vector<double> series;
+    for (std::size_t i = 0; i < settled; i += stride) series.push_back(states[i][observable]);
+    if (series.size() >= static_cast<std::size_t>(ZeroOneOptions{}.min_samples)) {
+      K = std::max(K, zero_one_test(series, ZeroOneOptions{}).K);
+    }
+  }
+  // The torus test on the stretch: the points do not lie on a smooth curve.
+  double digits = 0.0;  // not measured (under 200 points): no curve seen
+  if (settled >= static_cast<std::size_t>(WeightedBirkhoffOptions{}.min_points)) {
+    digits = weighted_birkhoff_test(
+                 as_rows(std::vector<Vector>(states.begin(),
+                                             states.begin() + static_cast<std::ptrdiff_t>(settled))))
+                 .digits;
+  }
+  const ClassifierOptions rules;
+  out.chaotic = K >= rules.regular_K && digits < rules.curve_digits;
+  return out;
 }
 
 // One evaluation with the settings' method: the record, adaptive evidence and refinement.
@@ -277,6 +449,11 @@ PointResult evaluate_record(const PointCase& point, const Vector& initial_state,
   }
   std::vector<Vector> points;
   points.reserve(static_cast<std::size_t>(s.recorded_periods));
+  // The transient's stroboscopic states, kept for the search for a chaotic transient (small
+  // structures only: a long chain keeps no more than its record).
+  const bool keep_history = n <= PointSettings::kRefinedMasses;
+  std::vector<Vector> history;
+  if (keep_history) history.reserve(static_cast<std::size_t>(s.transient_periods));
   // What the integrator can do decides which estimates are possible, never its name.
   const bool lyapunov = s.lyapunov && s.recorded_periods >= 10;
   const bool tangent = lyapunov && integrator->has_tangent_map() &&
@@ -393,6 +570,18 @@ PointResult evaluate_record(const PointCase& point, const Vector& initial_state,
         verdict = classify_motion(points, evidence, options);
       }
     }
+    // The torus test of a record without a period (weighted_birkhoff.hpp), one more indicator
+    // for rule 4 of the classifier: a smooth invariant curve or not.
+    result.torus_digits = result.rotation = std::numeric_limits<double>::quiet_NaN();
+    WeightedBirkhoffOptions torus;
+    if (verdict.period_search.period == 0 && verdict.regime != Regime::unbounded &&
+        recorded >= torus.min_points) {
+      const WeightedBirkhoffResult w = weighted_birkhoff_test(as_rows(points), torus);
+      result.torus_digits = w.digits;
+      if (w.has_rotation) result.rotation = w.rotation_number;
+      evidence.torus_digits = w.digits;
+      verdict = classify_motion(points, evidence, options);
+    }
     return verdict;
   };
   Classification c;
@@ -400,7 +589,8 @@ PointResult evaluate_record(const PointCase& point, const Vector& initial_state,
     for (int k = 1; k <= s.transient_periods; ++k) {
       period_now = k;
       if (hyperplane && k == s.transient_periods) sampler.record_crossings(record_crossing);
-      sampler.advance_to_strobe(k, nullptr, steps_of(k));
+      StrobePoint strobe = sampler.advance_to_strobe(k, nullptr, steps_of(k));
+      if (keep_history) history.push_back(std::move(strobe.state));
     }
     if (hyperplane && s.transient_periods == 0) sampler.record_crossings(record_crossing);
     record(s.transient_periods + 1, total);
@@ -447,8 +637,40 @@ PointResult evaluate_record(const PointCase& point, const Vector& initial_state,
   }
   result.regime = c.name();
   result.period = c.regime == Regime::periodic ? c.period : 0;
+  result.disagreement = c.readings;
   if (c.regime == Regime::unbounded || !result.final_state.allFinite()) result.final_state.resize(0);
   refine_regime(point, s, points, result);
+  // Transient chaos, on a motion that ends on a cycle: one the verdict is (the record's period,
+  // or refinement's orbit the motion is on), or the one the record's search found while λ1 over
+  // the whole record came out positive (rule 2 of the classifier: uncertain). In that last case
+  // the record holds the end of a chaotic transient: when the motion then stayed on the cycle for
+  // kChaoticTransient periods (and three cycles) the verdict is the period.
+  const bool on_cycle = result.period > 0 && (c.period_search.period == result.period ||
+                                              result.settle_periods == 0.0);
+  const bool settled_in_record = c.regime == Regime::uncertain && c.period_search.period > 0 &&
+                                 result.regime == "uncertain";
+  if (keep_history && (on_cycle || settled_in_record)) {
+    const int k = on_cycle ? result.period : c.period_search.period;
+    history.insert(history.end(), std::make_move_iterator(points.begin()),
+                   std::make_move_iterator(points.end()));
+    points.clear();
+    const Settling settling =
+        find_chaotic_transient(point, method, s.section.phase, history, k, observable);
+    const std::size_t stayed = history.size() - settling.settled;
+    if (settling.chaotic && (on_cycle || stayed >= static_cast<std::size_t>(
+                                                       std::max(kChaoticTransient, 3 * k)))) {
+      result.chaotic_transient = static_cast<int>(settling.settled);
+      result.regime = regime_name(Regime::periodic, k);
+      result.period = k;
+      result.disagreement.clear();
+    }
+    const std::size_t from = history.size() - std::min(history.size(), kTailPoints);
+    if (tail != nullptr && result.final_state.size() != 0) {
+      tail->assign(history.begin() + static_cast<std::ptrdiff_t>(from), history.end());
+    }
+    if (observer != nullptr) observer->classified(c, result);
+    return result;
+  }
   if (tail != nullptr && result.final_state.size() != 0) {
     const std::size_t from = points.size() - std::min(points.size(), kTailPoints);
     tail->assign(points.begin() + static_cast<std::ptrdiff_t>(from), points.end());
@@ -525,12 +747,6 @@ double start_coordinate(int m, Index c) {
   z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
   z ^= z >> 31;
   return 2.0 * (static_cast<double>(z >> 11) * 0x1.0p-53) - 1.0;
-}
-
-Matrix as_rows(const std::vector<Vector>& states) {
-  Matrix m(static_cast<Index>(states.size()), states.empty() ? 0 : states.front().size());
-  for (std::size_t i = 0; i < states.size(); ++i) m.row(static_cast<Index>(i)) = states[i];
-  return m;
 }
 
 }  // namespace

@@ -201,11 +201,21 @@ void analyze(const AnalyzeOptions& o) {
              result.lambda1_error, result.lambda1 / period,
              estimate_description(s.lyapunov_estimate, std::string(method.label)));
   fmt::print("  0-1 test: K = {:.3f}\n", result.K);
+  if (std::isfinite(result.torus_digits)) {
+    fmt::print("  torus test: {:.2f} digits (weighted Birkhoff averages of the record's halves; a "
+               "smooth invariant curve scores 5 or more), rotation number {:.6f} turns per period\n",
+               result.torus_digits, result.rotation);
+  }
   fmt::print("  rule: {}\n",
              c ? c->reason
                : std::string(result.regime == "unbounded"
                                  ? "the motion left the divergence bound before the record ended"
                                  : "a contact problem (LCP) had no solution"));
+  if (result.chaotic_transient > 0) {
+    fmt::print("  transient chaos: the motion wandered chaotically for its first {} periods (finite-"
+               "time λ1 > 0 along them), then settled on its period-{} orbit\n",
+               result.chaotic_transient, result.period);
+  }
   // Orbit refinement (orbit_refinement.hpp) when the record is called quasi-periodic or uncertain,
   // which a slow approach to a periodic orbit can look like: the periodic orbit the motion is on
   // or approaching, if Newton finds one from the motion's last state (at phase 0: a whole number

@@ -197,7 +197,7 @@ std::string first_difference(const std::string& recorded, const std::string& now
 // The format of the journals (sweep_journal.hpp), recorded in config.txt after the study's
 // description. A folder whose config.txt lacks it holds journals whose checksums leave the ids
 // out, which this version does not read.
-constexpr std::string_view kJournalFormat = "journal_format = 3\n";
+constexpr std::string_view kJournalFormat = "journal_format = 4\n";
 
 std::vector<fs::path> journal_files(const fs::path& folder) {
   std::vector<fs::path> files;

@@ -25,10 +25,15 @@
 //     margin), negative (λ1 + error < -margin), inconclusive (otherwise) or unknown; K as chaotic
 //     (K > chaotic_K), regular (K < regular_K), in between, or unknown.
 //       - unbounded, by secular growth (rule 4a below), unless λ1 is negative;
-//       - positive and chaotic                  -> chaotic
+//     The torus test (evidence.torus_digits, weighted Birkhoff averages) reads curve (digits >=
+//     curve_digits), broken (< broken_digits), in between, or unknown.
+//       - positive and chaotic, not a curve     -> chaotic
 //       - zero and regular                      -> quasi-periodic
-//       - positive, K unknown                   -> chaotic        (unless require_all_indicators)
-//       - λ1 unknown, chaotic                   -> chaotic        (unless require_all_indicators)
+//       - curve, K regular or in between, λ1 zero or inconclusive with |λ1| <= its error
+//                                               -> quasi-periodic
+//       - curve, positive                       -> uncertain (a curve contradicts chaos)
+//       - positive, K unknown, not a curve      -> chaotic        (unless require_all_indicators)
+//       - λ1 unknown, chaotic, not a curve      -> chaotic        (unless require_all_indicators)
 //       - zero, K unknown                       -> quasi-periodic (unless require_all_indicators)
 //       - λ1 unknown, regular                   -> quasi-periodic (unless require_all_indicators)
 //       - anything else (disagreement, an inconclusive or in-between value, λ1 < 0 without a
@@ -103,6 +108,8 @@ struct MotionEvidence {
   std::optional<double> lyapunov;        // λ1, finite
   double lyapunov_error = 0.0;           // its uncertainty (>= 0), e.g. LyapunovResult::error
   std::optional<double> zero_one_K;      // K from an earlier 0-1 test, in [-1, 1]
+  // The torus test's digits (weighted_birkhoff.hpp, WeightedBirkhoffResult::digits), >= 0.
+  std::optional<double> torus_digits;
   std::vector<double> observable;        // a scalar series for the 0-1 test, if K is not given
   // The time of points[0] since the initial state, in iterations of the map (forcing periods of
   // a stroboscopic map); the points are one iteration apart. Rule 4a measures growth against it:
@@ -116,6 +123,17 @@ struct ClassifierOptions {
   double lyapunov_margin = 5e-3;    // |λ1| within this counts as zero (> 0)
   double chaotic_K = 0.8;           // K above this is chaotic
   double regular_K = 0.2;           // K below this is regular (0 < regular_K <= chaotic_K < 1)
+  // The torus test, when its digits are given (rule 4): at least curve_digits reads a smooth
+  // invariant curve, below broken_digits no curve (0 < broken_digits <= curve_digits <= 15).
+  // A curve vetoes chaos and settles a λ1 or K that are inconclusive; the lack of one is not
+  // enough to call chaos without λ1 and K (tori of these structures can score low: below).
+  // Why 5 and 2.5: on the paper's 5-DOF chain (weighted_birkhoff.hpp) a loop scores 3.8 digits
+  // from 500 points and 5.9 from 4000, chaos 1.3 to 1.9; over the 1160 cells of the (θ, α) map
+  // (500 to 4000 points) 90% of the chaotic cells score below 2.2 and the quasi-periodic ones
+  // 1.0 to 6.0, median 3.5. So a high score is strong evidence of a curve, a low one is evidence
+  // against it only together with λ1.
+  double curve_digits = 5.0;
+  double broken_digits = 2.5;
   double divergence_bound = 1e12;   // |coordinate| beyond this is unbounded (> 0)
   // A fixed point of the map is an equilibrium (autonomous system sampled in time) or, when
   // false, a period-1 response (stroboscopic map of a forced system).
@@ -142,7 +160,14 @@ struct Classification {
   double lyapunov_error = 0.0;
   std::optional<double> zero_one_K;     // given or computed; empty when not available or not needed
   std::string zero_one_source;          // "given", "observable", "points", or empty
+  std::optional<double> torus_digits;   // as given
   std::string reason;                   // the rule that decided, with the numbers
+  // For an uncertain verdict, what each indicator read, as one token without spaces or commas
+  // (for result files): "period:none;lambda1:positive;K:between;torus:broken" (rule 4; lambda1
+  // positive|zero|negative|inconclusive|unknown, K chaotic|regular|between|unknown, torus
+  // curve|broken|between|unknown), "period:7;lambda1:positive" (rule 2), "points:too-few"
+  // (rule 3); empty for other verdicts.
+  std::string readings;
   // Rule 4a's fitted power of t of the amplitude's envelope over the whole record, when it ran
   // (no period found, enough points, λ1 not negative).
   std::optional<double> growth_exponent;
@@ -151,7 +176,7 @@ struct Classification {
 };
 
 // Throws InputError for invalid options, no points, points of differing dimensions, a non-finite
-// λ1 or K, a negative lyapunov_error, K outside [-1, 1], a first_point_time that is not positive
+// λ1 or K, negative or non-finite torus digits, a negative lyapunov_error, K outside [-1, 1], a first_point_time that is not positive
 // and finite, or an observable_component out of range when K is to be computed from the points.
 // Non-finite points are not an error: they are rule 1.
 Classification classify_motion(const std::vector<Vector>& points,

@@ -49,7 +49,11 @@
 //     the whole, rising and falling along the way (measured: a check on one distance 255
 //     periods on passed a cell of the (θ, α) map, α = 6.5, θ = 1.91, whose motion stays 0.04 from
 //     a stable period-1 orbit for 40000 periods). An attracting orbit whose approach is not
-//     confirmed does not describe the motion.
+//     confirmed does not describe the motion, and neither does one whose halving takes longer
+//     than max_check_periods allow (the check then predicts a shrinking by less than half, which
+//     a motion on a torus around the orbit can mimic: measured on figure 5's chain at α = 5,
+//     θ = 1.8, a torus whose rotation lies within 1e-8 of 295/963 and a period-963 orbit that
+//     would be reached after about 390000 periods).
 //
 // The estimate of the periods to settle is asymptotic: it holds once the slowest mode dominates
 // the distance, and it is of the order of the truth, not an exact count (tests/orbits/
@@ -70,6 +74,10 @@ namespace pwl::orbits {
 struct RefinementOptions {
   int max_period = 300;   // longest candidate period (forcing periods), >= 1
   int candidates = 3;     // periods tried at most, >= 1
+  // The periods to try, in order, instead of step 1's candidates (each in 1..max_period): a
+  // period the record's search already found (period_detection.hpp), to be checked by Newton.
+  // Empty: the candidates of step 1.
+  std::vector<int> periods;
   // The motion is on the orbit when its last state is within this of the orbit, relative to
   // max(1, |y|_∞); also the distance the periods to settle are counted to.
   double on_orbit_tolerance = 1e-8;

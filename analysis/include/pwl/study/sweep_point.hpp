@@ -104,8 +104,12 @@ struct PointSettings {
   // periods up to this many forcing periods; 0 (the library's default) leaves the verdict to the
   // record alone. When it finds a periodic orbit the motion is on, or an attracting one the
   // motion is confirmed to approach, the point is "period-k" with the periods it still needs in
-  // PointResult::settle_periods. Structures of more than kRefinedMasses degrees of freedom are
-  // not refined (Newton carries 2n tangent columns through up to this many periods).
+  // PointResult::settle_periods. Two more checks ride on it: a record whose rotation number
+  // (PointResult::rotation) lies within 1e-3/q² of a fraction p/q with q <= 1000 is tried at q (an orbit
+  // locked on a torus, beyond the period search), and a period the record's search found above
+  // 32 is checked by Newton at that period (not confirmed: "uncertain"). Structures of more than
+  // kRefinedMasses degrees of freedom are not refined (Newton carries 2n tangent columns through
+  // up to this many periods).
   int refine_max_period = 0;
   static constexpr int kRefinedMasses = 20;
   // How many of the recorded points are kept: 0 every one, N > 0 only the last N (the last N
@@ -151,6 +155,21 @@ struct PointResult {
   int extra_periods = 0;
   // "exact" when the exact solver's run decided the point (PointSettings::confirm), else empty.
   std::string confirmed_by;
+  // The torus test (weighted_birkhoff.hpp) of a record without a period: the digits on which the
+  // weighted Birkhoff averages of its two halves agree (high on a smooth invariant curve, about 1
+  // to 2 on chaos), and the rotation number in the plane of the first two state components, in
+  // turns per forcing period; NaN when not measured (a period found, or fewer than 200 points).
+  double torus_digits = std::numeric_limits<double>::quiet_NaN();
+  double rotation = std::numeric_limits<double>::quiet_NaN();
+  // For an uncertain point, which indicators disagree: the classifier's readings
+  // (Classification::readings), or "period:k;newton:not-confirmed" for a long period Newton did
+  // not confirm; empty otherwise.
+  std::string disagreement;
+  // Transient chaos: a motion that settled on its period-k orbit after wandering chaotically
+  // (finite-time λ1 clearly positive and K > 0.8 over the stretch) for this many forcing periods
+  // from the start; 0 when none was found (or not looked for: more than kRefinedMasses degrees
+  // of freedom, or no period).
+  int chaotic_transient = 0;
   // Distinct attractors reached from the point's starts (PointSettings::starts > 1, the
   // attractor at infinity counted); 0 when not counted.
   int attractors = 0;
