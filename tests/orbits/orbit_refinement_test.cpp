@@ -124,13 +124,7 @@ TEST_CASE("an attracting orbit the motion does not approach is not taken for the
   // on), while a stable period-1 orbit coexists with it. After 300 periods Newton from the last
   // state at period 1 (the only candidate allowed here) converges to the period-1 orbit,
   // attracting; the motion is not approaching it.
-  NondimensionalChain c;
-  c.masses = 1;
-  c.alpha = {0.5};
-  c.zeta = 0.001;
-  c.gap = {0.5};
-  c.amplitude = {0.5};
-  c.theta = 0.8;
+  const NondimensionalChain c = pwl::test::one_mass(0.5, 0.001, 0.5, 0.5, 0.8);
   StroboscopicMap map(analysis::PointCase(c), MethodSettings{Method::exact}, 1);
   const std::vector<Vector> early = pwl::test::poincare_points(map, Vector::Zero(2), 300, 300);
   RefinementOptions only_one;

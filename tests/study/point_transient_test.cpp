@@ -112,14 +112,7 @@ TEST_CASE("transient chaos that ends on a period-7 orbit of the chain is reporte
 TEST_CASE("transient chaos of one gap oscillator, ending on a period-8 orbit through the contact",
           "[sweep_point][transient]") {
   // x'' + 0.1 x' + x + 20 max(0, x − 0.5) = sin(2.2 t) from rest. Measured: 2018 periods.
-  NondimensionalChain c;
-  c.masses = 1;
-  c.alpha = {20.0};
-  c.zeta = 0.05;
-  c.gap = {0.5};
-  c.amplitude = {1.0};
-  c.theta = 2.2;
-  check_chaotic_transient(PointCase(c), 8, 1500, 3400);
+  check_chaotic_transient(PointCase(pwl::test::one_mass(20.0, 0.05, 0.5, 1.0, 2.2)), 8, 1500, 3400);
 }
 
 TEST_CASE("a short settling and a slow spiral are not transient chaos", "[sweep_point][transient]") {

@@ -34,32 +34,30 @@ inline Vector state_of(const Integrator& integrator) {
   return y;
 }
 
-// The hardening gap oscillator of the continuation-sweep test (tests/study/parameter_sweep_test):
-// one mass of the nondimensional chain, α = 3, ζ = 0.1, Δ̃ = 1.5, Q = 0.5; its resonance bends to
-// higher θ once the mass reaches the gap, with two folds and hysteresis between them.
-inline NondimensionalChain hardening_oscillator(double theta) {
+// One mass of the nondimensional chain, its gap spring to the ground: x'' + 2ζ x' + x + α max(0,
+// x − Δ̃) = Q sin(θ t).
+inline NondimensionalChain one_mass(double alpha, double zeta, double gap, double amplitude,
+                                    double theta) {
   NondimensionalChain c;
   c.masses = 1;
-  c.alpha = {3.0};
-  c.zeta = 0.1;
-  c.gap = {1.5};
-  c.amplitude = {0.5};
+  c.alpha = {alpha};
+  c.zeta = zeta;
+  c.gap = {gap};
+  c.amplitude = {amplitude};
   c.theta = theta;
   return c;
 }
 
+// The hardening gap oscillator of the continuation-sweep test (tests/study/parameter_sweep_test):
+// one mass of the nondimensional chain, α = 3, ζ = 0.1, Δ̃ = 1.5, Q = 0.5; its resonance bends to
+// higher θ once the mass reaches the gap, with two folds and hysteresis between them.
+inline NondimensionalChain hardening_oscillator(double theta) {
+  return one_mass(3.0, 0.1, 1.5, 0.5, theta);
+}
+
 // The undamped linear resonance of the chain's one mass (α = 0, ζ = 0, Q = 1, θ = 1): its amplitude
 // grows like t from every initial state.
-inline NondimensionalChain undamped_resonance() {
-  NondimensionalChain c;
-  c.masses = 1;
-  c.alpha = {0.0};
-  c.zeta = 0.0;
-  c.gap = {0.0};
-  c.amplitude = {1.0};
-  c.theta = 1.0;
-  return c;
-}
+inline NondimensionalChain undamped_resonance() { return one_mass(0.0, 0.0, 0.0, 1.0, 1.0); }
 
 // x'' + 2ζ x' + x + α max(0, x − Δ) = q sin(θ t): one unit mass, one gap spring to the ground.
 struct GapOscillator {

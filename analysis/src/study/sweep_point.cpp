@@ -649,11 +649,12 @@ PointResult evaluate_record(const PointCase& point, const Vector& initial_state,
                                               result.settle_periods == 0.0);
   const bool settled_in_record = c.regime == Regime::uncertain && c.period_search.period > 0 &&
                                  result.regime == "uncertain";
+  const std::vector<Vector>* motion = &points;  // the states the tail comes from
   if (keep_history && (on_cycle || settled_in_record)) {
     const int k = on_cycle ? result.period : c.period_search.period;
     history.insert(history.end(), std::make_move_iterator(points.begin()),
                    std::make_move_iterator(points.end()));
-    points.clear();
+    motion = &history;
     const Settling settling =
         find_chaotic_transient(point, method, s.section.phase, history, k, observable);
     const std::size_t stayed = history.size() - settling.settled;
@@ -664,16 +665,10 @@ PointResult evaluate_record(const PointCase& point, const Vector& initial_state,
       result.period = k;
       result.disagreement.clear();
     }
-    const std::size_t from = history.size() - std::min(history.size(), kTailPoints);
-    if (tail != nullptr && result.final_state.size() != 0) {
-      tail->assign(history.begin() + static_cast<std::ptrdiff_t>(from), history.end());
-    }
-    if (observer != nullptr) observer->classified(c, result);
-    return result;
   }
   if (tail != nullptr && result.final_state.size() != 0) {
-    const std::size_t from = points.size() - std::min(points.size(), kTailPoints);
-    tail->assign(points.begin() + static_cast<std::ptrdiff_t>(from), points.end());
+    const std::size_t from = motion->size() - std::min(motion->size(), kTailPoints);
+    tail->assign(motion->begin() + static_cast<std::ptrdiff_t>(from), motion->end());
   }
   if (observer != nullptr) observer->classified(c, result);
   return result;
