@@ -107,9 +107,9 @@ void add_scaling(CLI::App& bench) {
   auto unshared = std::make_shared<bool>(false);
   CLI::App* c = bench.add_subcommand(
       "scaling",
-      "Time per step and peak memory of the banded PIM for n = 1000 ... 256000, beside the bare\n"
-      "banded products of one step\n"
-      "Example: pwl bench scaling --sizes 1000,4000,16000,64000,256000");
+      "Time per step and peak memory of the banded PIM for n = 1000 ... 10^6, beside the bare\n"
+      "banded products of one step, on one thread and on all (OpenMP row blocks from 10^5 rows)\n"
+      "Example: pwl bench scaling --sizes 1000,16000,256000,1000000");
   c->add_option("--sizes", o->sizes, "Numbers of masses, comma separated")
       ->delimiter(',')
       ->check(number_at_least(2));

@@ -2,14 +2,16 @@
 // `pwl bench scaling`: time per step and peak memory of the banded PIM on the paper's chain as n
 // grows (1000 to 256000 masses), beside the time of the bare banded products of one step, the
 // floor of the stepper's own arithmetic. Each size runs in a child process of its own, so that
-// its peak resident memory is its own (getrusage of the child).
+// its peak resident memory is its own (getrusage of the child). Besides the single-thread CPU
+// time, each size is timed by the wall clock on one thread and on all of OpenMP's threads: the
+// banded products spread their rows over the threads from 10^5 rows on (banded_matrix.hpp).
 #include <string>
 #include <vector>
 
 namespace pwl::app {
 
 struct ScalingBenchOptions {
-  std::vector<long> sizes{1000, 4000, 16000, 64000, 256000};
+  std::vector<long> sizes{1000, 4000, 16000, 64000, 256000, 1000000};
   double step = 0.02;       // s, the paper's step
   int steps = 1000;         // timed steps per repeat (after 20 steps from rest)
   int repeats = 5;          // at least; small chains repeat more (same work per size)
@@ -29,6 +31,9 @@ struct ScalingRow {
   long stored_rows = 0;         // distinct rows of T stored
   int repeats = 0;
   double peak_rss_mb = 0.0;     // peak resident memory of the process that ran this size
+  int threads = 1;              // OpenMP threads of the threaded timing
+  double wall_one_us = 0.0;     // wall time per step on one thread
+  double wall_threads_us = 0.0; // ... on `threads` threads
 };
 
 // Runs the sizes (each in a child process running `self_exe bench scaling --single n ...`),

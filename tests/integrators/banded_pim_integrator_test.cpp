@@ -2,8 +2,12 @@
 // step, on chains with contacts, uniform and with cells that differ.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cstdint>
 #include <random>
+#include <utility>
+
+#include <omp.h>
 
 #include "pwl/integrators/banded_pim_integrator.hpp"
 #include "pwl/integrators/banded_propagator.hpp"
@@ -176,4 +180,28 @@ TEST_CASE("The banded stepper validates its input and reports divergence", "[ban
   auto integrator = make_banded_pim_integrator(pushed, o);
   integrator->set_state(0.0, Vector::Zero(60), Vector::Zero(60));
   CHECK_THROWS_AS(integrator->advance_to(1000.0), DivergenceError);
+}
+
+TEST_CASE("A long chain's steps spread over threads give the one-thread motion to the bit",
+          "[banded][threads]") {
+  // 60000 masses: 120000 state rows, past the 10^5 rows from which the tiles of a step go to the
+  // OpenMP threads (thread_rows.hpp). Each row's sum is the same on any thread, so the motion
+  // and the spring forces must agree exactly, contacts included.
+  const GapStructure s = make_chain(paper_large_chain(60000));
+  const BandedStepOperators ops = make_banded_step_operators(s, 0.1, BandedExponentialOptions{});
+  const Vector rest = Vector::Zero(s.dofs());
+  const auto run = [&](int threads) {
+    omp_set_num_threads(threads);
+    BandedPropagator p(ops);
+    p.set_state(0.0, rest, rest);
+    for (int k = 0; k < 100; ++k) p.step();
+    return std::make_pair(Vector(p.state()), p.spring_forces());
+  };
+  const int threads = std::max(2, omp_get_max_threads());
+  const auto one = run(1);
+  const auto many = run(threads);
+  omp_set_num_threads(threads);
+  REQUIRE(one.second.cwiseAbs().maxCoeff() > 0.0);  // springs in contact
+  CHECK((one.first - many.first).cwiseAbs().maxCoeff() == 0.0);
+  CHECK((one.second - many.second).cwiseAbs().maxCoeff() == 0.0);
 }

@@ -1,9 +1,13 @@
 // BandedMatrix against dense Eigen arithmetic: storage, shared rows, products.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
+#include <tuple>
+
+#include <omp.h>
 
 #include "pwl/numerics/banded_matrix.hpp"
 #include "pwl/errors.hpp"
@@ -136,6 +140,55 @@ TEST_CASE("Products with sparse matrices, diagonal shifts and row selection", "[
   REQUIRE(even.rows() == 20);
   for (Index r = 0; r < 20; ++r) CHECK((even.to_dense().row(r) - A.row(2 * r)).cwiseAbs().maxCoeff() == 0.0);
   CHECK_THROWS_AS(multiply(B, to_sparse(Matrix::Ones(5, 5))), InputError);
+  // The band of a sparse matrix's stored non-zeros: the same matrix, the band as narrow as the
+  // widest row needs (explicit zeros left out).
+  for (const Matrix& D : {A, R, L, S}) {
+    SparseMatrix sparse = to_sparse(D);
+    const BandedMatrix from_sparse = BandedMatrix::from_sparse_nonzeros(sparse);
+    CHECK(max_abs(from_sparse.to_dense() - D) == 0.0);
+    CHECK(from_sparse.width() == BandedMatrix::from_dense_nonzeros(D).width());
+  }
+  SparseMatrix with_zero = to_sparse(Matrix::Identity(4, 6));
+  with_zero.coeffRef(0, 5) = 0.0;  // stored, but zero
+  CHECK(BandedMatrix::from_sparse_nonzeros(with_zero).width() == 1);
+}
+
+TEST_CASE("Products over 10^5 rows and more give the one-thread result to the bit", "[banded][threads]") {
+  // 250000 rows, every row stored (random values), so that the row blocks of the threads cross
+  // segment boundaries anywhere.
+  const Index rows = 250000, cols = 250000, width = 7;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  BandedMatrixBuilder builder(rows, cols, width, false);
+  std::vector<double> row(static_cast<std::size_t>(width));
+  for (Index i = 0; i < rows; ++i) {
+    for (double& v : row) v = u(rng);
+    builder.set_row(i, std::clamp<Index>(i - width / 2, 0, cols - width), row.data(), width);
+  }
+  const BandedMatrix A = builder.build();
+  const Vector x = random_vector(cols, rng), y0 = random_vector(rows, rng);
+  const auto products = [&](int threads) {
+    omp_set_num_threads(threads);
+    Vector y(rows), z = y0, w = y0;
+    A.multiply(x.data(), y.data());
+    A.multiply_add(x.data(), z.data());
+    const double largest = A.multiply_add_max_abs(x.data(), w.data());
+    return std::make_tuple(y, z, w, largest);
+  };
+  const int threads = std::max(2, omp_get_max_threads());
+  const auto [y1, z1, w1, m1] = products(1);
+  const auto [y2, z2, w2, m2] = products(threads);
+  omp_set_num_threads(threads);
+  CHECK((y1 - y2).cwiseAbs().maxCoeff() == 0.0);
+  CHECK((z1 - z2).cwiseAbs().maxCoeff() == 0.0);
+  CHECK((w1 - w2).cwiseAbs().maxCoeff() == 0.0);
+  CHECK(m1 == m2);
+  CHECK(m1 == w1.cwiseAbs().maxCoeff());
+  // A NaN in the last row is reported as infinity whichever thread meets it.
+  Vector bad = x;
+  bad[cols - 1] = std::numeric_limits<double>::quiet_NaN();
+  Vector v = y0;
+  CHECK(std::isinf(A.multiply_add_max_abs(bad.data(), v.data())));
 }
 
 TEST_CASE("The builder rejects runs outside the matrix and unset rows", "[banded]") {

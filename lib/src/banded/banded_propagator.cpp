@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "numerics/thread_rows.hpp"
 #include "pwl/errors.hpp"
 #include "pwl/numerics/state_checks.hpp"
 
@@ -197,28 +198,51 @@ void BandedPropagator::step() {
   // forces acting, Ψ P_k is added afterwards from their columns, and the rows and springs it
   // touches are checked and formed again.
   const bool many_acting = 4 * static_cast<Index>(acting_.size()) > m;
-  double largest = 0.0;
-  std::size_t next = 0;  // into by_final_dof_
-  Index spring = 0;      // springs [0, spring) formed
-  std::size_t tile = 0;
-  for (Index r0 = 0; r0 < rows; r0 += kTileRows, ++tile) {
-    const Index r1 = std::min(rows, r0 + kTileRows);
+  // One tile: v̄'s rows [r0, r1), returning their largest |v̄_i|.
+  const auto tile_rows = [&](Index r0, Index r1) {
+    double tile_largest = 0.0;
     ops_.transition.multiply(state_.data(), bar, r0, r1);
     if (many_acting) ops_.force_now.multiply_add(forces_.data(), bar, r0, r1);
     if (harmonics_.cols() > 0) {
-      largest = std::max(largest, harmonics_.multiply_add_max_abs(harmonic_weights_.data(), bar,
-                                                                  r0, r1));
+      tile_largest = harmonics_.multiply_add_max_abs(harmonic_weights_.data(), bar, r0, r1);
     } else {
-      for (Index r = r0; r < r1; ++r) largest = larger(largest, bar[r]);
+      for (Index r = r0; r < r1; ++r) tile_largest = larger(tile_largest, bar[r]);
     }
-    if (!tile_springs_end_.empty()) {
-      const Index end = tile_springs_end_[tile];
-      gap_matrix_.multiply(bar, q_.data(), spring, end);
-      for (Index j = spring; j < end; ++j) q_[j] += offsets_[j];
-      spring = end;
-    } else {
-      while (next < by_final_dof_.size() && 2 * final_dof(by_final_dof_[next]) < r1) {
-        form_q(by_final_dof_[next++]);
+    // Infinity for a NaN, so that the largest over the tiles keeps it.
+    return std::isnan(tile_largest) ? std::numeric_limits<double>::infinity() : tile_largest;
+  };
+  // The springs finished by one tile, [begin, end), formed from its rows.
+  const auto tile_springs = [&](std::size_t tile) {
+    const Index begin = tile == 0 ? 0 : tile_springs_end_[tile - 1];
+    const Index end = tile_springs_end_[tile];
+    gap_matrix_.multiply(bar, q_.data(), begin, end);
+    for (Index j = begin; j < end; ++j) q_[j] += offsets_[j];
+  };
+  double largest = 0.0;
+  const auto tiles = static_cast<std::size_t>((rows + kTileRows - 1) / kTileRows);
+  const bool by_tiles = springs_.empty() || tile_springs_end_.size() == tiles;
+  if (by_tiles && numerics_detail::spread_rows(rows)) {
+    // Long chains (10^5 masses and more): the tiles spread over the threads. Each tile writes
+    // its own rows of v̄ and its own springs of q, so the result is the serial one to the bit.
+    const auto count = static_cast<long>(tiles);
+#pragma omp parallel for schedule(static) reduction(max : largest)
+    for (long tile = 0; tile < count; ++tile) {
+      const Index r0 = static_cast<Index>(tile) * kTileRows;
+      largest = std::max(largest, tile_rows(r0, std::min(rows, r0 + kTileRows)));
+      if (!springs_.empty()) tile_springs(static_cast<std::size_t>(tile));
+    }
+  } else {
+    std::size_t next = 0;  // into by_final_dof_
+    std::size_t tile = 0;
+    for (Index r0 = 0; r0 < rows; r0 += kTileRows, ++tile) {
+      const Index r1 = std::min(rows, r0 + kTileRows);
+      largest = std::max(largest, tile_rows(r0, r1));
+      if (by_tiles) {
+        if (!springs_.empty()) tile_springs(tile);
+      } else {
+        while (next < by_final_dof_.size() && 2 * final_dof(by_final_dof_[next]) < r1) {
+          form_q(by_final_dof_[next++]);
+        }
       }
     }
   }

@@ -43,6 +43,44 @@ std::vector<RowBlock> partition_rows(Index n, Index margin, Index cell) {
   return blocks;
 }
 
+CellRepeats::CellRepeats(const GapStructure& s, Index cell, const std::vector<LoadGroup>& loads) {
+  const Index n = s.dofs();
+  const auto same_column = [&](const SparseMatrix& A, Index i, Index shift) {
+    SparseMatrix::InnerIterator a(A, i), b(A, i - shift);
+    for (; a && b; ++a, ++b) {
+      if (a.row() - i != b.row() - (i - shift) || a.value() != b.value()) return false;
+    }
+    return !a && !b;
+  };
+  const auto fill = [&](Index shift) {
+    differing_.assign(static_cast<std::size_t>(n + 1), 0);
+    for (Index i = 0; i < n; ++i) {
+      bool repeats = i >= shift;
+      for (const SparseMatrix* A : {&s.mass, &s.damping, &s.stiffness}) {
+        repeats = repeats && same_column(*A, i, shift);
+      }
+      for (const LoadGroup& g : loads) {
+        repeats = repeats && g.sin_part[i] == g.sin_part[i - shift] &&
+                  g.cos_part[i] == g.cos_part[i - shift];
+      }
+      differing_[static_cast<std::size_t>(i + 1)] =
+          differing_[static_cast<std::size_t>(i)] + (repeats ? 0 : 1);
+    }
+  };
+  if (cell <= 0) return;  // no cell: nothing repeats
+  const Index lo = n / 4, hi = n - n / 4;
+  for (Index k = 1; k <= 8; ++k) {
+    shift_ = k * cell;
+    if (hi - lo < 2 * shift_) break;
+    fill(shift_);
+    if (differing_[static_cast<std::size_t>(hi)] == differing_[static_cast<std::size_t>(lo + shift_)]) {
+      return;
+    }
+  }
+  shift_ = cell;
+  fill(shift_);
+}
+
 }  // namespace banded_detail
 
 Vector interleave_state(const Vector& x, const Vector& v) {
@@ -100,7 +138,9 @@ bool BandedExponentialOptions::is_valid(std::string* why) const {
 
 namespace {
 
+using banded_detail::CellRepeats;
 using banded_detail::RowBlock;
+using banded_detail::repeats_block;
 using banded_detail::partition_rows;
 
 // The operator blocks whose dropped parts are measured: the four blocks of T, and the
@@ -259,12 +299,18 @@ Assembly assemble(const GapStructure& s, double step, const std::vector<LoadGrou
   constexpr std::size_t kChunk = 256;
   std::vector<Entry*> used;
   std::vector<std::pair<Entry*, const RowBlock*>> missing;
+  const CellRepeats repeats(s, cell, loads);
   for (std::size_t c0 = 0; c0 < blocks.size(); c0 += kChunk) {
     const std::size_t c1 = std::min(blocks.size(), c0 + kChunk);
     used.clear();
     missing.clear();
     for (std::size_t b = c0; b < c1; ++b) {
       const RowBlock& block = blocks[b];
+      const auto back = static_cast<std::size_t>(repeats.shift() / std::max<Index>(cell, 1));
+      if (back > 0 && b >= c0 + back && repeats_block(blocks[b - back], block, repeats)) {
+        used.push_back(used[b - c0 - back]);  // that block's substructure, `back` cells on
+        continue;
+      }
       SubstructureKey key(s, block.window_first, block.window_last, loads);
       auto [it, inserted] = cache.try_emplace(std::move(key), Entry{nullptr, c0});
       it->second.chunk = c0;

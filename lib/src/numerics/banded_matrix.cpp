@@ -5,14 +5,18 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <mutex>
 #include <utility>
 
 #include <fmt/format.h>
-
+#include "numerics/thread_rows.hpp"
 #include "pwl/errors.hpp"
 
 namespace pwl {
 namespace {
+
+using numerics_detail::over_row_blocks;
+using numerics_detail::spread_rows;
 
 using RowMajorSparse = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 
@@ -200,14 +204,16 @@ void BandedMatrix::multiply(const double* x, double* y, Index row_begin, Index r
     std::fill(y + row_begin, y + row_end, 0.0);
     return;
   }
-  row_kernel<false>(width_)(*this, x, y, row_begin, row_end);
+  const RowKernel kernel = row_kernel<false>(width_);
+  over_row_blocks(row_begin, row_end, [&](Index b, Index e) { kernel(*this, x, y, b, e); });
 }
 
 void BandedMatrix::multiply_add(const double* x, double* y, Index row_begin,
                                 Index row_end) const {
   check_range(row_begin, row_end, rows_);
   if (width_ == 0) return;
-  row_kernel<true>(width_)(*this, x, y, row_begin, row_end);
+  const RowKernel kernel = row_kernel<true>(width_);
+  over_row_blocks(row_begin, row_end, [&](Index b, Index e) { kernel(*this, x, y, b, e); });
 }
 
 void BandedMatrix::transpose_multiply_add(const double* x, double* y) const {
@@ -239,6 +245,19 @@ double BandedMatrix::multiply_add_max_abs(const double* x, double* y) const {
 double BandedMatrix::multiply_add_max_abs(const double* x, double* y, Index row_begin,
                                           Index row_end) const {
   check_range(row_begin, row_end, rows_);
+  if (!spread_rows(row_end - row_begin)) return max_abs_rows(x, y, row_begin, row_end);
+  double largest = 0.0;
+  std::mutex lock;
+  over_row_blocks(row_begin, row_end, [&](Index b, Index e) {
+    const double mine = max_abs_rows(x, y, b, e);
+    const std::lock_guard<std::mutex> guard(lock);
+    largest = std::max(largest, mine);
+  });
+  return largest;
+}
+
+double BandedMatrix::max_abs_rows(const double* x, double* y, Index row_begin,
+                                  Index row_end) const {
   double largest = 0.0;
   bool finite = true;
   const auto update = [&](Index r, double d) PWL_ALWAYS_INLINE {
@@ -377,6 +396,36 @@ BandedMatrix BandedMatrix::from_dense_nonzeros(const Matrix& A) {
   return b.build();
 }
 
+BandedMatrix BandedMatrix::from_sparse_nonzeros(const SparseMatrix& A) {
+  const RowMajorSparse R(A);
+  Index width = A.cols() > 0 ? 1 : 0;
+  std::vector<Index> lo(static_cast<std::size_t>(A.rows()), 0), hi(lo);
+  for (Index i = 0; i < A.rows(); ++i) {
+    Index first = -1, last = -1;
+    for (RowMajorSparse::InnerIterator it(R, i); it; ++it) {
+      if (it.value() == 0.0) continue;
+      if (first < 0 || it.col() < first) first = it.col();
+      last = std::max(last, it.col());
+    }
+    if (first >= 0) {
+      lo[static_cast<std::size_t>(i)] = first;
+      hi[static_cast<std::size_t>(i)] = last + 1;
+      width = std::max(width, last + 1 - first);
+    }
+  }
+  BandedMatrixBuilder b(A.rows(), A.cols(), width);
+  std::vector<double> row(static_cast<std::size_t>(std::max<Index>(width, 1)));
+  for (Index i = 0; i < A.rows(); ++i) {
+    const Index f = lo[static_cast<std::size_t>(i)], l = hi[static_cast<std::size_t>(i)];
+    std::fill(row.begin(), row.end(), 0.0);
+    for (RowMajorSparse::InnerIterator it(R, i); it; ++it) {
+      if (it.value() != 0.0) row[static_cast<std::size_t>(it.col() - f)] = it.value();
+    }
+    b.set_row(i, f, row.data(), l - f);
+  }
+  return b.build();
+}
+
 // ---------------------------------------------------------------------------------------------
 
 BandedMatrixBuilder::BandedMatrixBuilder(Index rows, Index cols, Index width, bool share_rows)
@@ -430,6 +479,16 @@ std::int32_t BandedMatrixBuilder::intern(const double* row) {
   if (w == 0) {
     return 0;
   }
+  // A periodic structure's rows repeat within a few rows (the x and x' rows of a mass, then the
+  // same two one mass further): compared with the last rows stored or found first, they are
+  // found without hashing.
+  for (const std::int32_t p : recent_) {
+    if (p < 0) continue;
+    const double* stored = pool.data() + static_cast<std::size_t>(p) * static_cast<std::size_t>(w);
+    if (std::memcmp(stored, row, static_cast<std::size_t>(w) * sizeof(double)) == 0) {
+      return remember(p);
+    }
+  }
   const std::uint64_t h = hash_row(row, w);
   std::size_t mask = table_.size() - 1;
   std::size_t slot = static_cast<std::size_t>(h) & mask;
@@ -438,12 +497,12 @@ std::int32_t BandedMatrixBuilder::intern(const double* row) {
       const double* stored =
           pool.data() + static_cast<std::size_t>(table_[slot].pool) * static_cast<std::size_t>(w);
       if (std::memcmp(stored, row, static_cast<std::size_t>(w) * sizeof(double)) == 0) {
-        return table_[slot].pool;
+        return remember(table_[slot].pool);
       }
     }
     slot = (slot + 1) & mask;
   }
-  const std::int32_t index = append();
+  const std::int32_t index = remember(append());
   table_[slot] = Bucket{h, index};
   if (2 * ++table_used_ > table_.size()) {
     // Grow and re-insert.

@@ -5,6 +5,7 @@
 // (banded_switching_pim.cpp), which must cut a structure the same way; private to pwl_core.
 #include <vector>
 
+#include "pwl/model/gap_structure.hpp"
 #include "pwl/types.hpp"
 
 namespace pwl::banded_detail {
@@ -18,5 +19,42 @@ struct RowBlock {
 // cell size p, the interior blocks are single cells, so that their substructures coincide in a
 // periodic structure; the rows near each end form one block whose substructure holds that end.
 std::vector<RowBlock> partition_rows(Index n, Index margin, Index cell);
+
+// Which windows repeat exactly the window `shift()` degrees of freedom before them, found in
+// O(non-zeros) once, so that the blocks of a periodic stretch reuse an earlier block's
+// substructure without building and hashing a SubstructureKey each (what made the assembly's
+// cost per mass). The shift is the smallest multiple of the cell, up to 8 cells, under which the
+// middle half of the structure repeats with its loads (the paper's chain: cells of one mass,
+// loads alternating, shift 2). A degree of freedom repeats the one `shift` before it when its
+// columns of M, C and K (entries as offsets from the diagonal, with their values) and its loads
+// are the same; a window whose degrees of freedom all repeat holds the content of the window
+// `shift` before it (the entries it keeps are the same offsets from the same places).
+// Sufficient, not necessary: a window that fails simply takes the key lookup.
+class CellRepeats {
+ public:
+  CellRepeats(const GapStructure& structure, Index cell, const std::vector<LoadGroup>& loads);
+  Index shift() const { return shift_; }
+  // True when window [first, last) holds exactly the content of [first - shift, last - shift).
+  bool repeats_earlier(Index first, Index last) const {
+    return shift_ > 0 && first >= shift_ &&
+           differing_[static_cast<std::size_t>(last)] == differing_[static_cast<std::size_t>(first)];
+  }
+
+ private:
+  Index shift_ = 0;
+  std::vector<Index> differing_;  // differing_[i]: degrees of freedom below i that do not repeat
+};
+
+// True when `block` is `earlier` shifted by repeats.shift() along a stretch that repeats, so that
+// both read their rows off the same substructure at the same place.
+inline bool repeats_block(const RowBlock& earlier, const RowBlock& block,
+                          const CellRepeats& repeats) {
+  const Index shift = repeats.shift();
+  return block.window_first - earlier.window_first == shift &&
+         block.window_last - earlier.window_last == shift &&
+         block.end - block.begin == earlier.end - earlier.begin &&
+         block.begin - block.window_first == earlier.begin - earlier.window_first &&
+         repeats.repeats_earlier(block.window_first, block.window_last);
+}
 
 }  // namespace pwl::banded_detail

@@ -49,6 +49,8 @@ bool shifted_column_matches(const SparseMatrix& A, Index j, Index p) {
 SubstructureKey::SubstructureKey(const GapStructure& structure, Index first, Index last,
                                  const std::vector<LoadGroup>& loads) {
   check_window(structure, first, last);
+  content_.reserve(static_cast<std::size_t>(4 + 16 * (last - first) +
+                                            loads.size() * static_cast<std::size_t>(2 + 2 * (last - first))));
   content_.push_back(static_cast<double>(last - first));
   for (const SparseMatrix* A : {&structure.mass, &structure.damping, &structure.stiffness}) {
     content_.push_back(-1.0);  // separates the matrices

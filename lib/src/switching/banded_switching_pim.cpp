@@ -65,7 +65,34 @@ std::vector<BandedMatrix> banded_force_coefficients(const GapStructure& s, doubl
                      SubstructureKey::Hasher>
       cache;
   std::vector<double> row(static_cast<std::size_t>(2 * q + 1));
-  for (const RowBlock& block : blocks) {
+  // The rows of one block, read off its substructure's coefficients.
+  const auto set_rows = [&](const RowBlock& block, const std::vector<Matrix>& coefficients) {
+    const Index w = block.window_last - block.window_first, first = block.window_first;
+    for (Index i = block.begin; i < block.end; ++i) {
+      const Index li = i - first;
+      const Index lo = std::max<Index>(0, i - q), hi = std::min(n, i + q + 1);
+      const Index span = hi - lo, l0 = lo - first;
+      for (int a = 0; a < 2; ++a) {
+        const Index r = a * w + li;
+        for (std::size_t k = 0; k < count; ++k) {
+          for (Index j = 0; j < span; ++j) row[static_cast<std::size_t>(j)] = coefficients[k](r, l0 + j);
+          builders[k].set_row(2 * i + a, lo, row.data(), span);
+        }
+      }
+    }
+  };
+  // The coefficients do not depend on the loads: substructures repeat with the cells.
+  const banded_detail::CellRepeats repeats(s, cell, {});
+  const auto back = static_cast<std::size_t>(repeats.shift() / std::max<Index>(cell, 1));
+  std::vector<std::shared_ptr<const std::vector<Matrix>>> of_block(blocks.size());
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    const RowBlock& block = blocks[b];
+    if (back > 0 && b >= back && of_block[b - back] &&
+        banded_detail::repeats_block(blocks[b - back], block, repeats)) {
+      of_block[b] = of_block[b - back];  // that block's substructure, `back` cells on
+      set_rows(block, *of_block[b]);
+      continue;
+    }
     SubstructureKey key(s, block.window_first, block.window_last);
     auto it = cache.find(key);
     if (it == cache.end()) {
@@ -83,20 +110,8 @@ std::vector<BandedMatrix> banded_force_coefficients(const GapStructure& s, doubl
       all->push_back(std::move(c.slope));
       it = cache.emplace(std::move(key), std::move(all)).first;
     }
-    const std::vector<Matrix>& coefficients = *it->second;
-    const Index w = block.window_last - block.window_first, first = block.window_first;
-    for (Index i = block.begin; i < block.end; ++i) {
-      const Index li = i - first;
-      const Index lo = std::max<Index>(0, i - q), hi = std::min(n, i + q + 1);
-      const Index span = hi - lo, l0 = lo - first;
-      for (int a = 0; a < 2; ++a) {
-        const Index r = a * w + li;
-        for (std::size_t k = 0; k < count; ++k) {
-          for (Index j = 0; j < span; ++j) row[static_cast<std::size_t>(j)] = coefficients[k](r, l0 + j);
-          builders[k].set_row(2 * i + a, lo, row.data(), span);
-        }
-      }
-    }
+    of_block[b] = it->second;
+    set_rows(block, *of_block[b]);
   }
   std::vector<BandedMatrix> out;
   out.reserve(count);
@@ -152,6 +167,14 @@ class BandedStepper final : public SwitchingPim,
     gap_rows_ = RowSparse(SparseMatrix(W.transpose()));
     spring_rows_ = RowSparse(stiffnesses_.asDiagonal() * gap_rows_);
     spring_offset_ = stiffnesses_.cwiseProduct(gaps_);
+    // The same operators as bands for the whole-state products of every step (the Taylor
+    // recursion, the gaps, the LCP's right-hand side): a chain's rows repeat, so these stream the
+    // vectors; the sparse forms above serve the local corrections' row-by-row sums.
+    stiffness_band_ = BandedMatrix::from_sparse_nonzeros(SparseMatrix(stiffness_part_));
+    damping_band_ = BandedMatrix::from_sparse_nonzeros(SparseMatrix(damping_part_));
+    force_band_ = BandedMatrix::from_sparse_nonzeros(force_part);
+    gap_band_ = BandedMatrix::from_sparse_nonzeros(W.transpose());
+    spring_band_ = BandedMatrix::from_sparse_nonzeros(SparseMatrix(spring_rows_));
     // The reach of one Taylor term: the farthest two rows that K, C or a spring couple.
     for (const RowSparse* part : {&stiffness_part_, &damping_part_, &gap_rows_}) {
       for (Index i = 0; i < part->outerSize(); ++i) {
@@ -368,7 +391,7 @@ class BandedStepper final : public SwitchingPim,
       transition_.multiply(t_y_.data(), t_bar_.data());
       if (end_derivative_) t_slope_.setZero(m_);
       for (int r = 0; r <= last && m_ > 0; ++r) {
-        t_g_.noalias() = gap_rows_ * t_x_;
+        band_product(gap_band_, t_x_, t_g_);
         t_p_ = start_mode_.cwiseProduct(stiffnesses_.cwiseProduct(t_g_));
         const auto ru = static_cast<std::size_t>(r);
         add_forces(correction_[ru], correction_columns_[ru], t_p_, t_bar_, start_acting_);
@@ -376,9 +399,9 @@ class BandedStepper final : public SwitchingPim,
         if (r == last) break;
         const double f = eta_ / (r + 1);
         if (r < d_) {
-          t_acc_.noalias() = stiffness_part_ * t_x_;
-          t_acc_.noalias() += damping_part_ * t_u_;
-          if (!start_acting_.empty()) t_acc_.noalias() += force_part_ * t_p_;
+          band_product(stiffness_band_, t_x_, t_acc_);
+          damping_band_.multiply_add(t_u_.data(), t_acc_.data());
+          if (!start_acting_.empty()) force_band_.multiply_add(t_p_.data(), t_acc_.data());
         }
         t_x_ = f * t_u_;
         if (r < d_) t_u_ = f * t_acc_;
@@ -386,13 +409,13 @@ class BandedStepper final : public SwitchingPim,
       if (m_ > 0 && !acting_.empty()) {
         // -dq = K2 W^T dbar_x; dz on the active set.
         for (Index i = 0; i < n_; ++i) t_half_[i] = t_bar_[2 * i];
-        t_g_.noalias() = spring_rows_ * t_half_;
+        band_product(spring_band_, t_half_, t_g_);
         solve_active_set(acting_, t_g_, t_z_);
         add_forces(phi_, phi_columns_, t_z_, t_bar_);
         if (end_derivative_ && o_.locate_switches) {
           // The end-slope correction, with the slope of the new state (same mode at both ends).
           for (Index i = 0; i < n_; ++i) t_half_[i] = t_bar_[2 * i + 1];
-          t_g_.noalias() = gap_rows_ * t_half_;
+          band_product(gap_band_, t_half_, t_g_);
           t_slope_ = eta_ * mode_.cwiseProduct(stiffnesses_.cwiseProduct(t_g_)) - t_slope_;
           add_forces(slope_, slope_columns_, t_slope_, t_bar_);
         }
@@ -468,11 +491,16 @@ class BandedStepper final : public SwitchingPim,
 
   // The hooks of ModeSeries (switching_pim_detail.hpp), which holds the Taylor recursion and the
   // pieces of switching steps, here with sparse products; xs_[0] and us_[0] hold the start.
-  void gap_product(const Vector& x, Vector& out) const { out.noalias() = gap_rows_ * x; }
+  void gap_product(const Vector& x, Vector& out) const { band_product(gap_band_, x, out); }
   void acceleration(const Vector& x, const Vector& u, const Vector& p, Vector& acc) const {
-    acc.noalias() = stiffness_part_ * x;
-    acc.noalias() += damping_part_ * u;
-    if (!acting_.empty()) acc.noalias() += force_part_ * p;
+    band_product(stiffness_band_, x, acc);
+    damping_band_.multiply_add(u.data(), acc.data());
+    if (!acting_.empty()) force_band_.multiply_add(p.data(), acc.data());
+  }
+  // out = A x (out resized; it must not be x).
+  static void band_product(const BandedMatrix& A, const Vector& x, Vector& out) {
+    out.resize(A.rows());
+    A.multiply(x.data(), out.data());
   }
   double kink_tolerance(Index j) const {
     double reach = 0.0;
@@ -518,7 +546,8 @@ class BandedStepper final : public SwitchingPim,
     if (m_ > 0) {
       for (Index i = 0; i < n_; ++i) half_[i] = bar_[2 * i];
       q_ = spring_offset_;
-      q_.noalias() -= spring_rows_ * half_;
+      spring_band_.multiply(half_.data(), spring_force_.data());
+      q_ -= spring_force_;
       if (!lcp_synced_) {
         // Warm start from the mode (z must be zero outside the active set).
         z_ = mode_;
@@ -545,7 +574,8 @@ class BandedStepper final : public SwitchingPim,
     if (end_derivative_ && o_.locate_switches && !acting_.empty()) {
       // Correct with the slope the new state gives (the mode is the same at both ends).
       for (Index i = 0; i < n_; ++i) half_[i] = state_[2 * i + 1];
-      slope_guess_ = eta_ * mode_.cwiseProduct(stiffnesses_.cwiseProduct(gap_rows_ * half_)) -
+      band_product(gap_band_, half_, spring_force_);
+      slope_guess_ = eta_ * mode_.cwiseProduct(stiffnesses_.cwiseProduct(spring_force_)) -
                      slope_guess_;
       add_forces(slope_, slope_columns_, slope_guess_, state_);
     }
@@ -613,6 +643,8 @@ class BandedStepper final : public SwitchingPim,
   BandedMatrix phi_, phi_columns_;          // ... of P_{k+1}
   BandedMatrix slope_, slope_columns_;      // ... of the end-slope correction
   RowSparse stiffness_part_, damping_part_, force_part_, gap_rows_, spring_rows_;
+  BandedMatrix stiffness_band_, damping_band_, force_band_, gap_band_, spring_band_;
+  Vector spring_force_ = Vector::Zero(m_);  // scratch: K2 W^T x or W^T x' of a step
   Vector gaps_, stiffnesses_, spring_offset_, abs_row_sums_;
   std::vector<LoadTerm> loads_;
 

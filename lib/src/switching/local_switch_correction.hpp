@@ -207,18 +207,19 @@ class LocalSwitchCorrection {
       record.base_mode = base_mode_;
       record.terms = R;
     }
-    outside_settings_ = st.settings_;  // the kinks settled at the step's start
-    // The first switch, on y_u for every spring (the first piece has δ = 0).
+    keep_candidates();
+    // The first switch, on y_u for every spring that can switch (the first piece has δ = 0).
     {
       const event_detail::SearchResult& first =
-          st.locator_.find_first_crossing(st.poly_, st.start_, 1.0, outside_settings_);
+          st.locator_.find_first_crossing(candidate_poly_, outside_start_, 1.0, outside_settings_);
       st.diagnostics_.gap_samples += first.samples;
       if (!first.found) {
         finish_local(std::move(record), keep);
         return true;
       }
       sigma_ = first.at.t;
-      found_.assign(first.springs.begin(), first.springs.end());
+      found_.clear();
+      for (Index k : first.springs) found_.push_back(candidates_[static_cast<std::size_t>(k)]);
     }
     ensure_terms(max_terms);
     // A throw from here on (a step the springs chatter through, a series that does not converge)
@@ -669,14 +670,59 @@ class LocalSwitchCorrection {
     }
     out_valid_ = true;
     event_detail::SearchSettings& s = outside_settings_;
-    for (Index j : mask_) s.certified_until[j] = std::numeric_limits<double>::infinity();
+    for (Index j : mask_) {
+      const int k = candidate_of_[static_cast<std::size_t>(j)];
+      if (k >= 0) s.certified_until[k] = std::numeric_limits<double>::infinity();
+    }
     outside_start_ = event_detail::GapSample();
-    st.poly_.sample(outside_start_, sigma_, outside_start_);
-    const event_detail::SearchResult& r = st.locator_.find_first_crossing(st.poly_, outside_start_, 1.0, s);
+    candidate_poly_.sample(outside_start_, sigma_, outside_start_);
+    const event_detail::SearchResult& r =
+        st.locator_.find_first_crossing(candidate_poly_, outside_start_, 1.0, s);
     st.diagnostics_.gap_samples += r.samples;
     out_found_ = r.found;
     out_sigma_ = r.found ? r.at.t : 1.0;
-    out_springs_.assign(r.springs.begin(), r.springs.end());
+    out_springs_.clear();
+    for (Index k : r.springs) out_springs_.push_back(candidates_[static_cast<std::size_t>(k)]);
+  }
+
+  // The springs whose gap on y_u can reach its kink in the step, with their polynomials, search
+  // settings and samples at σ = 0 (outside_settings_, outside_start_), for the searches on y_u.
+  // Left out: the springs whose mode-signed gap e(σ) = Σ c_r σ^r is certainly positive on [0, 1]
+  // (e >= c_0 + c_1 σ - S σ² with S = Σ_{r>=2} |c_r|, a concave bound positive at both ends, with
+  // a margin for the rounding of the evaluation) and that the search would examine from σ = 0
+  // on. The search never examines a spring before its kink could be reached, so leaving these
+  // out changes what it finds only through its sample spacing (which they could only shorten);
+  // a chain whose springs switch in one region no longer samples all of them after each switch.
+  void keep_candidates() {
+    Stepper& st = me();
+    const Matrix& c = st.poly_.c;
+    const Index m = c.rows(), R = c.cols() - 1;
+    candidates_.clear();
+    candidate_of_.assign(static_cast<std::size_t>(m), -1);
+    for (Index j = 0; j < m; ++j) {
+      double rest = 0.0;
+      for (Index r = 2; r <= R; ++r) rest += std::abs(c(j, r));
+      const double c1 = R >= 1 ? c(j, 1) : 0.0;
+      const double margin = 8.0 * kEpsilon * (std::abs(c(j, 0)) + std::abs(c1) + rest);
+      const bool clear = c(j, 0) > margin && c(j, 0) + c1 - rest > margin &&
+                         st.settings_.tolerance[j] == 0.0 && !(st.settings_.certified_until[j] > 0.0);
+      if (clear) continue;
+      candidate_of_[static_cast<std::size_t>(j)] = static_cast<int>(candidates_.size());
+      candidates_.push_back(j);
+    }
+    const auto count = static_cast<Index>(candidates_.size());
+    candidate_poly_.c.resize(count, R + 1);
+    outside_settings_ = st.settings_;  // spacing and widths; the kinks settled at the start
+    outside_settings_.tolerance.resize(count);
+    outside_settings_.certified_until.resize(count);
+    for (Index k = 0; k < count; ++k) {
+      const Index j = candidates_[static_cast<std::size_t>(k)];
+      candidate_poly_.c.row(k) = c.row(j);
+      outside_settings_.tolerance[k] = st.settings_.tolerance[j];
+      outside_settings_.certified_until[k] = st.settings_.certified_until[j];
+    }
+    outside_start_ = event_detail::GapSample();
+    candidate_poly_.sample(outside_start_, 0.0, outside_start_);
   }
 
   // The tangent of a recorded step applied to every column of Y.
@@ -775,6 +821,11 @@ class LocalSwitchCorrection {
   bool out_valid_ = false, out_found_ = false;
   double out_sigma_ = 1.0;
   std::vector<Index> out_springs_;
+  // The springs y_u's searches look at (keep_candidates) and their polynomials; candidate_of_ is
+  // a spring's row there, -1 for a spring left out.
+  std::vector<Index> candidates_;
+  std::vector<int> candidate_of_;
+  PolynomialGaps candidate_poly_;
   // Tangent: y_u's tangent gaps at the step's sources, and the records kept for replay.
   Matrix tangent_gaps_;
   int tangent_terms_ = 0;

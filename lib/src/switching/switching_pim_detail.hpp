@@ -33,16 +33,15 @@ class PolynomialGaps final : public event_detail::ModeGaps {
     out.e.resize(m);
     out.rate.resize(m);
     out.accel.resize(m);
-    for (Index j = 0; j < m; ++j) {
-      double e = c(j, R), r = 0.0, a = 0.0;
-      for (Index k = R - 1; k >= 0; --k) {
-        a = a * s + 2.0 * r;
-        r = r * s + e;
-        e = e * s + c(j, k);
-      }
-      out.e[j] = e;
-      out.rate[j] = r;
-      out.accel[j] = a;
+    // Horner's rule for every spring at once, column by column (contiguous, vectorised): the
+    // value, the first and the second derivative.
+    out.e = c.col(R);
+    out.rate.setZero();
+    out.accel.setZero();
+    for (Index k = R - 1; k >= 0; --k) {
+      out.accel = out.accel * s + 2.0 * out.rate;
+      out.rate = out.rate * s + out.e;
+      out.e = out.e * s + c.col(k);
     }
   }
 

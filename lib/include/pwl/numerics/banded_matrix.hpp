@@ -55,7 +55,8 @@ class BandedMatrix {
   Index lower_bandwidth() const;
   Index upper_bandwidth() const;
 
-  // y = A x and y += A x. x has cols() entries, y rows(). y must not alias x.
+  // y = A x and y += A x. x has cols() entries, y rows(). y must not alias x. Products over
+  // 10^5 rows or more are spread over the OpenMP threads in row blocks (same result to the bit).
   void multiply(const double* x, double* y) const;
   void multiply_add(const double* x, double* y) const;
   // The same for rows [row_begin, row_end) only (a tile of a longer sweep).
@@ -81,6 +82,10 @@ class BandedMatrix {
   static BandedMatrix from_dense(const Matrix& A, Index half_width);
   // The band that holds every non-zero of A: each row's run starts at its first non-zero.
   static BandedMatrix from_dense_nonzeros(const Matrix& A);
+  // The same for a sparse matrix, in O(non-zeros): the equation of motion's K, C and spring
+  // directions of a chain as banded operators, whose products stream their vectors (the rows of
+  // a uniform chain are stored once) instead of gathering through column indices.
+  static BandedMatrix from_sparse_nonzeros(const SparseMatrix& A);
 
   static constexpr int kMaxPeriod = 8;
   // Rows [row_begin, row_end): row row_begin + k·period + φ stores pool row pool[φ] + k·pool_step
@@ -102,6 +107,7 @@ class BandedMatrix {
  private:
   friend class BandedMatrixBuilder;
   void find_segments();
+  double max_abs_rows(const double* x, double* y, Index row_begin, Index row_end) const;
   Index rows_ = 0;
   Index cols_ = 0;
   Index width_ = 0;
@@ -132,6 +138,13 @@ class BandedMatrixBuilder {
     std::int32_t pool;
   };
   std::int32_t intern(const double* row);
+  // Notes pool row p as the most recently used one (recent_, newest first) and returns it.
+  std::int32_t remember(std::int32_t p) {
+    if (recent_[0] == p) return p;
+    for (std::size_t k = recent_.size() - 1; k > 0; --k) recent_[k] = recent_[k - 1];
+    recent_[0] = p;
+    return p;
+  }
 
   BandedMatrix matrix_;
   bool share_;
@@ -140,6 +153,7 @@ class BandedMatrixBuilder {
   // Open-addressing table of stored rows by hash.
   std::vector<Bucket> table_;
   std::size_t table_used_ = 0;
+  std::array<std::int32_t, BandedMatrix::kMaxPeriod> recent_{-1, -1, -1, -1, -1, -1, -1, -1};
 };
 
 // Products that build the step's operators (sizes must agree; InputError otherwise).
