@@ -136,6 +136,35 @@ TEST_CASE("Chains whose cells differ get their band from local substructures", "
         }
     }
   }
+  // A periodic chain with loads that alternate (windows repeat every two masses) and local
+  // defects outside its middle half (still cell 1): the rows near a defect come from their own
+  // substructures, the repeating stretches reuse one (CellRepeats); T and the load responses
+  // against the dense ones.
+  {
+    ChainParameters p = paper_large_chain(90);
+    p.k1.assign(90, 1.0);
+    p.k1[12] = 3.0;
+    p.damping.assign(90, 0.2);
+    p.damping[75] = 0.5;
+    p.loads[80].amplitude = -0.7;
+    const GapStructure d = make_chain(p);
+    const BandedExponential b = make_banded_exponential(d, 0.1);
+    CHECK(b.truncation.cell_dofs == 1);
+    const PimStepOperators ops = make_pim_step_operators(d, 0.1);
+    CHECK(banded_error(b.transition, ops.transition, 90) <= b.truncation.tolerance + kRounding);
+    for (std::size_t g = 0; g < ops.harmonics.size(); ++g) {
+      double worst = 0.0;
+      for (Index i = 0; i < 90; ++i)
+        for (int a = 0; a < 2; ++a) {
+          worst = std::max({worst,
+                            std::abs(b.harmonics[g].sin_response[2 * i + a] -
+                                     ops.harmonics[g].sin_response[a * 90 + i]),
+                            std::abs(b.harmonics[g].cos_response[2 * i + a] -
+                                     ops.harmonics[g].cos_response[a * 90 + i])});
+        }
+      CHECK(worst < 1e-15);
+    }
+  }
   // Cells of two masses that alternate are detected and give the same result as undeclared.
   ChainParameters alternating = paper_large_chain(60);
   alternating.mass.clear();

@@ -153,6 +153,42 @@ TEST_CASE("Products with sparse matrices, diagonal shifts and row selection", "[
   CHECK(BandedMatrix::from_sparse_nonzeros(with_zero).width() == 1);
 }
 
+TEST_CASE("Stencil and row-wise products agree to rounding", "[banded]") {
+  // A chain-like operator: boundary rows of their own, then one row repeated one column further
+  // each row (a Toeplitz band, applied as a stencil when stored once), for widths 1 to 8 and
+  // both products. The same matrix with every row stored takes the row-wise path.
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (Index width = 1; width <= 8; ++width) {
+    const Index rows = 300, cols = rows + width;
+    std::vector<double> interior(static_cast<std::size_t>(width)), row(interior.size());
+    for (double& v : interior) v = u(rng);
+    BandedMatrixBuilder shared(rows, cols, width, true), every(rows, cols, width, false);
+    for (Index i = 0; i < rows; ++i) {
+      const bool boundary = i < 3 || i >= rows - 4;
+      for (std::size_t k = 0; k < row.size(); ++k) row[k] = boundary ? u(rng) : interior[k];
+      shared.set_row(i, i, row.data(), width);
+      every.set_row(i, i, row.data(), width);
+    }
+    const BandedMatrix stencil = shared.build(), row_wise = every.build();
+    REQUIRE(stencil.stored_rows() <= 8);
+    REQUIRE(row_wise.stored_rows() == rows);
+    const Vector x = random_vector(cols, rng), y0 = random_vector(rows, rng);
+    const Matrix D = stencil.to_dense();
+    Vector a(rows), b(rows), c = y0, d = y0;
+    stencil.multiply(x.data(), a.data());
+    row_wise.multiply(x.data(), b.data());
+    stencil.multiply_add(x.data(), c.data());
+    row_wise.multiply_add(x.data(), d.data());
+    const double scale = static_cast<double>(width) * 4.0 * std::numeric_limits<double>::epsilon();
+    INFO("width " << width);
+    CHECK((a - b).cwiseAbs().maxCoeff() <= scale);
+    CHECK((a - D * x).cwiseAbs().maxCoeff() <= scale);
+    CHECK((c - d).cwiseAbs().maxCoeff() <= 2.0 * scale);
+    CHECK((c - (y0 + D * x)).cwiseAbs().maxCoeff() <= 2.0 * scale);
+  }
+}
+
 TEST_CASE("Products over 10^5 rows and more give the one-thread result to the bit", "[banded][threads]") {
   // 250000 rows, every row stored (random values), so that the row blocks of the threads cross
   // segment boundaries anywhere.

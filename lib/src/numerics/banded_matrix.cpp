@@ -105,17 +105,53 @@ void generic_rows(const BandedMatrix& A, const double* x, double* y, Index r0, I
   });
 }
 
+// Up to this width, stretches where one stored row repeats one column further each row (a
+// Toeplitz band: K, C and the spring directions of a uniform chain) are applied as a stencil:
+// the W coefficients held in registers and the rows swept together, vectorised across rows
+// instead of one short dot product per row.
+constexpr int kStencilWidth = 8;
+
 template <int W, bool Add>
 void fixed_rows(const BandedMatrix& A, const double* x, double* y, Index r0, Index r1) {
   using Row = Eigen::Matrix<double, W, 1>;
-  for_each_row(A, r0, r1, [&](Index r, const double* a, Index first) PWL_ALWAYS_INLINE {
-    const double d = Eigen::Map<const Row>(a).dot(Eigen::Map<const Row>(x + first));
-    if constexpr (Add) {
-      y[r] += d;
-    } else {
-      y[r] = d;
+  const auto by_rows = [&](Index b, Index e) {
+    for_each_row(A, b, e, [&](Index r, const double* a, Index first) PWL_ALWAYS_INLINE {
+      const double d = Eigen::Map<const Row>(a).dot(Eigen::Map<const Row>(x + first));
+      if constexpr (Add) {
+        y[r] += d;
+      } else {
+        y[r] = d;
+      }
+    });
+  };
+  if constexpr (W > kStencilWidth) {
+    by_rows(r0, r1);
+  } else {
+    const auto& segments = A.row_segments();
+    auto it = std::upper_bound(segments.begin(), segments.end(), r0,
+                               [](Index r, const BandedMatrix::Segment& s) { return r < s.row_end; });
+    for (; it != segments.end() && it->row_begin < r1; ++it) {
+      const BandedMatrix::Segment& s = *it;
+      const Index begin = std::max(s.row_begin, r0), end = std::min(s.row_end, r1);
+      if (s.period != 1 || s.pool_step != 0 || s.column_step != 1) {
+        by_rows(begin, end);
+        continue;
+      }
+      std::array<double, W> a{};
+      std::copy_n(A.pool_row(s.pool[0]), W, a.begin());
+      // Row r's run starts at column r + shift.
+      const double* xs = x + (s.first[0] - s.row_begin);
+      for (Index r = begin; r < end; ++r) {
+        double d = a[0] * xs[r];
+        for (int k = 1; k < W; ++k) d += a[static_cast<std::size_t>(k)] * xs[r + k];
+        if constexpr (Add) {
+          y[r] += d;
+        } else {
+          y[r] = d;
+        }
+      }
     }
-  });
+  }
 }
 
 template <bool Add, int... Ws>

@@ -23,9 +23,10 @@
 // windowed series is the whole-state series of δ, term for term, not an approximation; between
 // pieces δ's rows are trimmed where it is below ε² of the motion (no digit of the state). The
 // switches are located on the gap polynomials of y_u + δ for the springs near the window and on
-// y_u's alone for the others (one search for them, repeated only when a spring they found joins
-// the window). The step's end is y_u(η) + δ(η). Work per switching step: one whole-state series
-// (which every switching step pays to find its first switch) and, per piece, O(terms · window)
+// y_u's alone for the others (one search for them, over the springs whose gaps can reach their
+// kinks in the step, CandidateSprings, repeated only when a spring it found joins the window).
+// The step's end is y_u(η) + δ(η). Work per switching step: one whole-state series (which every
+// switching step pays to find its first switch) and, per piece, O(terms · window)
 // instead of O(terms · n).
 //
 // The tangent map follows the same split with the same pieces: the whole-step series of y_u's
@@ -207,19 +208,19 @@ class LocalSwitchCorrection {
       record.base_mode = base_mode_;
       record.terms = R;
     }
-    keep_candidates();
-    // The first switch, on y_u for every spring that can switch (the first piece has δ = 0).
+    // The first switch, on y_u for every spring that can switch in the step (the first piece has
+    // δ = 0); the same springs for the later searches on y_u (outside_search).
+    outside_.select(st.poly_, st.settings_);
     {
-      const event_detail::SearchResult& first =
-          st.locator_.find_first_crossing(candidate_poly_, outside_start_, 1.0, outside_settings_);
+      const event_detail::SearchResult& first = st.locator_.find_first_crossing(
+          outside_.poly, outside_.start, 1.0, outside_.settings);
       st.diagnostics_.gap_samples += first.samples;
       if (!first.found) {
         finish_local(std::move(record), keep);
         return true;
       }
       sigma_ = first.at.t;
-      found_.clear();
-      for (Index k : first.springs) found_.push_back(candidates_[static_cast<std::size_t>(k)]);
+      outside_.springs_of(first, found_);
     }
     ensure_terms(max_terms);
     // A throw from here on (a step the springs chatter through, a series that does not converge)
@@ -669,60 +670,19 @@ class LocalSwitchCorrection {
       if (still && (!out_found_ || out_sigma_ >= sigma_)) return;
     }
     out_valid_ = true;
-    event_detail::SearchSettings& s = outside_settings_;
+    event_detail::SearchSettings& s = outside_.settings;
     for (Index j : mask_) {
-      const int k = candidate_of_[static_cast<std::size_t>(j)];
+      const int k = outside_.row_of[static_cast<std::size_t>(j)];
       if (k >= 0) s.certified_until[k] = std::numeric_limits<double>::infinity();
     }
     outside_start_ = event_detail::GapSample();
-    candidate_poly_.sample(outside_start_, sigma_, outside_start_);
+    outside_.poly.sample(outside_start_, sigma_, outside_start_);
     const event_detail::SearchResult& r =
-        st.locator_.find_first_crossing(candidate_poly_, outside_start_, 1.0, s);
+        st.locator_.find_first_crossing(outside_.poly, outside_start_, 1.0, s);
     st.diagnostics_.gap_samples += r.samples;
     out_found_ = r.found;
     out_sigma_ = r.found ? r.at.t : 1.0;
-    out_springs_.clear();
-    for (Index k : r.springs) out_springs_.push_back(candidates_[static_cast<std::size_t>(k)]);
-  }
-
-  // The springs whose gap on y_u can reach its kink in the step, with their polynomials, search
-  // settings and samples at σ = 0 (outside_settings_, outside_start_), for the searches on y_u.
-  // Left out: the springs whose mode-signed gap e(σ) = Σ c_r σ^r is certainly positive on [0, 1]
-  // (e >= c_0 + c_1 σ - S σ² with S = Σ_{r>=2} |c_r|, a concave bound positive at both ends, with
-  // a margin for the rounding of the evaluation) and that the search would examine from σ = 0
-  // on. The search never examines a spring before its kink could be reached, so leaving these
-  // out changes what it finds only through its sample spacing (which they could only shorten);
-  // a chain whose springs switch in one region no longer samples all of them after each switch.
-  void keep_candidates() {
-    Stepper& st = me();
-    const Matrix& c = st.poly_.c;
-    const Index m = c.rows(), R = c.cols() - 1;
-    candidates_.clear();
-    candidate_of_.assign(static_cast<std::size_t>(m), -1);
-    for (Index j = 0; j < m; ++j) {
-      double rest = 0.0;
-      for (Index r = 2; r <= R; ++r) rest += std::abs(c(j, r));
-      const double c1 = R >= 1 ? c(j, 1) : 0.0;
-      const double margin = 8.0 * kEpsilon * (std::abs(c(j, 0)) + std::abs(c1) + rest);
-      const bool clear = c(j, 0) > margin && c(j, 0) + c1 - rest > margin &&
-                         st.settings_.tolerance[j] == 0.0 && !(st.settings_.certified_until[j] > 0.0);
-      if (clear) continue;
-      candidate_of_[static_cast<std::size_t>(j)] = static_cast<int>(candidates_.size());
-      candidates_.push_back(j);
-    }
-    const auto count = static_cast<Index>(candidates_.size());
-    candidate_poly_.c.resize(count, R + 1);
-    outside_settings_ = st.settings_;  // spacing and widths; the kinks settled at the start
-    outside_settings_.tolerance.resize(count);
-    outside_settings_.certified_until.resize(count);
-    for (Index k = 0; k < count; ++k) {
-      const Index j = candidates_[static_cast<std::size_t>(k)];
-      candidate_poly_.c.row(k) = c.row(j);
-      outside_settings_.tolerance[k] = st.settings_.tolerance[j];
-      outside_settings_.certified_until[k] = st.settings_.certified_until[j];
-    }
-    outside_start_ = event_detail::GapSample();
-    candidate_poly_.sample(outside_start_, 0.0, outside_start_);
+    outside_.springs_of(r, out_springs_);
   }
 
   // The tangent of a recorded step applied to every column of Y.
@@ -817,15 +777,12 @@ class LocalSwitchCorrection {
   std::vector<double> coefficients_, shifted_;
   PolynomialGaps local_poly_;
   event_detail::GapSample local_start_, outside_start_;
-  event_detail::SearchSettings local_settings_, outside_settings_;
+  event_detail::SearchSettings local_settings_;
   bool out_valid_ = false, out_found_ = false;
   double out_sigma_ = 1.0;
   std::vector<Index> out_springs_;
-  // The springs y_u's searches look at (keep_candidates) and their polynomials; candidate_of_ is
-  // a spring's row there, -1 for a spring left out.
-  std::vector<Index> candidates_;
-  std::vector<int> candidate_of_;
-  PolynomialGaps candidate_poly_;
+  // The springs y_u's searches look at, with their polynomials and search settings.
+  CandidateSprings outside_;
   // Tangent: y_u's tangent gaps at the step's sources, and the records kept for replay.
   Matrix tangent_gaps_;
   int tangent_terms_ = 0;

@@ -112,6 +112,60 @@ class PolynomialGaps final : public event_detail::ModeGaps {
   }
 };
 
+// The springs of a set of gap polynomials (PolynomialGaps, σ in [0, 1]) that can reach their
+// kink on the piece, with their polynomials, search settings and samples at σ = 0, for a search
+// that need not look at the others. Left out: the springs whose mode-signed gap
+// e(σ) = Σ c_r σ^r is certainly positive on [0, 1] (e >= c_0 + c_1 σ - S σ² with S = Σ_{r>=2} |c_r|,
+// a concave bound positive at both ends, with a margin for the rounding of the evaluation) and
+// that the search would examine from σ = 0 on (no kink tolerance, no certified departure). The
+// search never examines a spring before its kink could be reached, so leaving these out changes
+// what it finds only through its sample spacing, which they could only shorten; a chain whose
+// springs switch in one region no longer samples all of them at every sample.
+struct CandidateSprings {
+  std::vector<Index> springs;  // the springs kept (rows of the whole set), ascending
+  std::vector<int> row_of;     // each spring's row here, -1 for a spring left out
+  PolynomialGaps poly;
+  event_detail::SearchSettings settings;
+  event_detail::GapSample start;
+
+  void select(const PolynomialGaps& all, const event_detail::SearchSettings& all_settings) {
+    const Matrix& c = all.c;
+    const Index m = c.rows(), R = c.cols() - 1;
+    springs.clear();
+    row_of.assign(static_cast<std::size_t>(m), -1);
+    for (Index j = 0; j < m; ++j) {
+      double rest = 0.0;
+      for (Index r = 2; r <= R; ++r) rest += std::abs(c(j, r));
+      const double c1 = R >= 1 ? c(j, 1) : 0.0;
+      const double margin = 8.0 * kEpsilon * (std::abs(c(j, 0)) + std::abs(c1) + rest);
+      const bool clear = c(j, 0) > margin && c(j, 0) + c1 - rest > margin &&
+                         all_settings.tolerance[j] == 0.0 &&
+                         !(all_settings.certified_until[j] > 0.0);
+      if (clear) continue;
+      row_of[static_cast<std::size_t>(j)] = static_cast<int>(springs.size());
+      springs.push_back(j);
+    }
+    const auto count = static_cast<Index>(springs.size());
+    poly.c.resize(count, R + 1);
+    settings = all_settings;  // spacing and widths
+    settings.tolerance.resize(count);
+    settings.certified_until.resize(count);
+    for (Index k = 0; k < count; ++k) {
+      const Index j = springs[static_cast<std::size_t>(k)];
+      poly.c.row(k) = c.row(j);
+      settings.tolerance[k] = all_settings.tolerance[j];
+      settings.certified_until[k] = all_settings.certified_until[j];
+    }
+    start = event_detail::GapSample();
+    poly.sample(start, 0.0, start);
+  }
+  // The springs of a search's result, as rows of the whole set, into `out`.
+  void springs_of(const event_detail::SearchResult& r, std::vector<Index>& out) const {
+    out.clear();
+    for (Index k : r.springs) out.push_back(springs[static_cast<std::size_t>(k)]);
+  }
+};
+
 // The coefficients of the step's force polynomial from the moments Ξ̂_0 .. Ξ̂_{d+1} (Ξ̂_{d+2} with
 // the end slope) of polynomial_force_integrals: correction[r] multiplies p_r (with the end slope,
 // the predicted slope Σ r p_r folded in, and one more for p_{d+1}), phi multiplies P_{k+1},
@@ -506,9 +560,20 @@ class ModeSeries {
         for (Index j : flip_) st.set_mode(j, !(st.mode_[j] > 0.0));
         continue;
       }
+      // Long structures search only the springs that can switch in the piece (CandidateSprings);
+      // with a few springs, every one.
+      const bool screened = st.m_ >= kScreenedSprings;
+      if (screened) candidates_.select(poly_, settings_);
       const event_detail::SearchResult& r =
-          locator_.find_first_crossing(poly_, start_, 1.0, settings_);
+          screened ? locator_.find_first_crossing(candidates_.poly, candidates_.start, 1.0,
+                                                  candidates_.settings)
+                   : locator_.find_first_crossing(poly_, start_, 1.0, settings_);
       st.diagnostics_.gap_samples += r.samples;
+      if (screened) {
+        candidates_.springs_of(r, crossing_);
+      } else {
+        crossing_.assign(r.springs.begin(), r.springs.end());
+      }
       const double sigma = r.found ? r.at.t : 1.0;
       evaluate_series(R, sigma);
       if (tangent_ != nullptr) {
@@ -522,7 +587,7 @@ class ModeSeries {
       }
       if (r.found) {
         s = r.at.t >= 1.0 && whole ? st.eta_ : s + r.at.t * h;
-        for (Index j : r.springs) toggle(j);
+        for (Index j : crossing_) toggle(j);
       } else {
         s = whole ? st.eta_ : s + h;
       }
@@ -608,6 +673,11 @@ class ModeSeries {
   event_detail::GapSample start_;
   event_detail::SearchSettings settings_;
   std::vector<Index> flip_;
+  // The springs searched in a piece when there are kScreenedSprings or more, and the springs a
+  // search found crossing (rows of the whole set).
+  static constexpr Index kScreenedSprings = 64;
+  CandidateSprings candidates_;
+  std::vector<Index> crossing_;
   // The tangent record (see TangentOp).
   bool recording_ = false, record_open_ = false, record_complete_ = false, replaying_ = false;
   std::vector<TangentOp> record_;
