@@ -24,7 +24,7 @@ struct ChainBenchOptions {
   double wished_step = 0.32;   // s, η1 given to the step rule
   std::vector<int> rule_bands{5, 8};  // q given to the step rule (the paper: 5, its 11-dof piece)
   // Steps of the banded switching PIM (order 5, switches located), one row each.
-  std::vector<double> switching_steps{0.1, 0.04, 0.02};
+  std::vector<double> switching_steps{0.2, 0.1, 0.08, 0.04, 0.02};
   // Accuracy requests for the banded switching PIM (accuracy_step.hpp), one row each: the step
   // (dividing t_end) found on the first two periods of the loads (4π s) and the run at it, both
   // timed.
