@@ -47,15 +47,22 @@ using RowKernel = void (*)(const BandedMatrix&, const double*, double*, Index, I
 
 // Walks rows [r0, r1) segment by segment: body(row, stored values, first column). Periods 1
 // and 2 (a row per mass, or the x and x' rows of a mass) get loops of their own.
+// Walks the segments that meet rows [r0, r1): body(segment, first row, end row) on each one's
+// share of the range.
 template <class Body>
-inline void for_each_row(const BandedMatrix& A, Index r0, Index r1, Body&& body) {
-  const Index w = A.width();
+inline void for_each_segment(const BandedMatrix& A, Index r0, Index r1, Body&& body) {
   const auto& segments = A.row_segments();
   auto it = std::upper_bound(segments.begin(), segments.end(), r0,
                              [](Index r, const BandedMatrix::Segment& s) { return r < s.row_end; });
   for (; it != segments.end() && it->row_begin < r1; ++it) {
-    const BandedMatrix::Segment& s = *it;
-    const Index begin = std::max(s.row_begin, r0), end = std::min(s.row_end, r1);
+    body(*it, std::max(it->row_begin, r0), std::min(it->row_end, r1));
+  }
+}
+
+template <class Body>
+inline void for_each_row(const BandedMatrix& A, Index r0, Index r1, Body&& body) {
+  const Index w = A.width();
+  for_each_segment(A, r0, r1, [&](const BandedMatrix::Segment& s, Index begin, Index end) {
     const Index P = s.period, C = s.column_step;
     const Index values_step = static_cast<Index>(s.pool_step) * w;
     Index k = (begin - s.row_begin) / P, phase = (begin - s.row_begin) % P;
@@ -63,7 +70,7 @@ inline void for_each_row(const BandedMatrix& A, Index r0, Index r1, Body&& body)
     const Index f0 = s.first[0];
     if (P == 1) {
       for (Index r = begin; r < end; ++r, ++k) body(r, a0 + k * values_step, f0 + k * C);
-      continue;
+      return;
     }
     if (P == 2) {
       const double* a1 = A.pool_row(s.pool[1]);
@@ -79,7 +86,7 @@ inline void for_each_row(const BandedMatrix& A, Index r0, Index r1, Body&& body)
         body(r + 1, a1 + k * values_step, f1 + k * C);
       }
       if (r < end) body(r, a0 + k * values_step, f0 + k * C);
-      continue;
+      return;
     }
     for (Index r = begin; r < end; ++r) {
       body(r, A.pool_row(s.pool[static_cast<std::size_t>(phase)]) + k * values_step,
@@ -89,7 +96,7 @@ inline void for_each_row(const BandedMatrix& A, Index r0, Index r1, Body&& body)
         ++k;
       }
     }
-  }
+  });
 }
 
 template <bool Add>
@@ -127,15 +134,10 @@ void fixed_rows(const BandedMatrix& A, const double* x, double* y, Index r0, Ind
   if constexpr (W > kStencilWidth) {
     by_rows(r0, r1);
   } else {
-    const auto& segments = A.row_segments();
-    auto it = std::upper_bound(segments.begin(), segments.end(), r0,
-                               [](Index r, const BandedMatrix::Segment& s) { return r < s.row_end; });
-    for (; it != segments.end() && it->row_begin < r1; ++it) {
-      const BandedMatrix::Segment& s = *it;
-      const Index begin = std::max(s.row_begin, r0), end = std::min(s.row_end, r1);
+    for_each_segment(A, r0, r1, [&](const BandedMatrix::Segment& s, Index begin, Index end) {
       if (s.period != 1 || s.pool_step != 0 || s.column_step != 1) {
         by_rows(begin, end);
-        continue;
+        return;
       }
       std::array<double, W> a{};
       std::copy_n(A.pool_row(s.pool[0]), W, a.begin());
@@ -150,7 +152,7 @@ void fixed_rows(const BandedMatrix& A, const double* x, double* y, Index r0, Ind
           y[r] = d;
         }
       }
-    }
+    });
   }
 }
 
