@@ -222,14 +222,24 @@ void BandedPropagator::step() {
   const auto tiles = static_cast<std::size_t>((rows + kTileRows - 1) / kTileRows);
   const bool by_tiles = springs_.empty() || tile_springs_end_.size() == tiles;
   if (by_tiles && numerics_detail::spread_rows(rows)) {
-    // Long chains (10^5 masses and more): the tiles spread over the threads. Each tile writes
-    // its own rows of v̄ and its own springs of q, so the result is the serial one to the bit.
+    // Long chains (10^5 masses and more): the tiles spread over the threads, in two phases. A
+    // spring's row reads v̄ on both sides of a tile boundary (a spring between the last mass of
+    // one tile and the first of the next, and the padding of short rows), so every tile of v̄ is
+    // finished (the barrier at the end of the first loop) before any spring is formed. Each
+    // thread writes only its own rows of v̄ and its own springs of q: the result is the serial
+    // one to the bit.
     const auto count = static_cast<long>(tiles);
-#pragma omp parallel for schedule(static) reduction(max : largest)
-    for (long tile = 0; tile < count; ++tile) {
-      const Index r0 = static_cast<Index>(tile) * kTileRows;
-      largest = std::max(largest, tile_rows(r0, std::min(rows, r0 + kTileRows)));
-      if (!springs_.empty()) tile_springs(static_cast<std::size_t>(tile));
+#pragma omp parallel
+    {
+#pragma omp for schedule(static) reduction(max : largest)
+      for (long tile = 0; tile < count; ++tile) {
+        const Index r0 = static_cast<Index>(tile) * kTileRows;
+        largest = std::max(largest, tile_rows(r0, std::min(rows, r0 + kTileRows)));
+      }
+      if (!springs_.empty()) {
+#pragma omp for schedule(static)
+        for (long tile = 0; tile < count; ++tile) tile_springs(static_cast<std::size_t>(tile));
+      }
     }
   } else {
     std::size_t next = 0;  // into by_final_dof_

@@ -141,11 +141,12 @@ void fixed_rows(const BandedMatrix& A, const double* x, double* y, Index r0, Ind
       }
       std::array<double, W> a{};
       std::copy_n(A.pool_row(s.pool[0]), W, a.begin());
-      // Row r's run starts at column r + shift.
-      const double* xs = x + (s.first[0] - s.row_begin);
+      // Row begin + i's run starts at column first[0] + (begin - row_begin) + i.
+      const double* xs = x + s.first[0] + (begin - s.row_begin);
       for (Index r = begin; r < end; ++r) {
-        double d = a[0] * xs[r];
-        for (int k = 1; k < W; ++k) d += a[static_cast<std::size_t>(k)] * xs[r + k];
+        const double* xr = xs + (r - begin);
+        double d = a[0] * xr[0];
+        for (int k = 1; k < W; ++k) d += a[static_cast<std::size_t>(k)] * xr[k];
         if constexpr (Add) {
           y[r] += d;
         } else {

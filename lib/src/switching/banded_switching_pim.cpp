@@ -84,13 +84,15 @@ std::vector<BandedMatrix> banded_force_coefficients(const GapStructure& s, doubl
   // The coefficients do not depend on the loads: substructures repeat with the cells.
   const banded_detail::CellRepeats repeats(s, cell, {});
   const auto back = static_cast<std::size_t>(repeats.shift() / std::max<Index>(cell, 1));
-  std::vector<std::shared_ptr<const std::vector<Matrix>>> of_block(blocks.size());
+  // The coefficients of the last `back` blocks (block b at b % back), so that a structure whose
+  // cells all differ keeps no more than the cache's 64 sets alive.
+  std::vector<std::shared_ptr<const std::vector<Matrix>>> recent(std::max<std::size_t>(back, 1));
   for (std::size_t b = 0; b < blocks.size(); ++b) {
     const RowBlock& block = blocks[b];
-    if (back > 0 && b >= back && of_block[b - back] &&
+    auto& slot = recent[b % recent.size()];  // held block b - back until now
+    if (back > 0 && b >= back && slot &&
         banded_detail::repeats_block(blocks[b - back], block, repeats)) {
-      of_block[b] = of_block[b - back];  // that block's substructure, `back` cells on
-      set_rows(block, *of_block[b]);
+      set_rows(block, *slot);  // that block's substructure, `back` cells on
       continue;
     }
     SubstructureKey key(s, block.window_first, block.window_last);
@@ -110,8 +112,8 @@ std::vector<BandedMatrix> banded_force_coefficients(const GapStructure& s, doubl
       all->push_back(std::move(c.slope));
       it = cache.emplace(std::move(key), std::move(all)).first;
     }
-    of_block[b] = it->second;
-    set_rows(block, *of_block[b]);
+    slot = it->second;
+    set_rows(block, *slot);
   }
   std::vector<BandedMatrix> out;
   out.reserve(count);

@@ -137,7 +137,9 @@ struct CandidateSprings {
       double rest = 0.0;
       for (Index r = 2; r <= R; ++r) rest += std::abs(c(j, r));
       const double c1 = R >= 1 ? c(j, 1) : 0.0;
-      const double margin = 8.0 * kEpsilon * (std::abs(c(j, 0)) + std::abs(c1) + rest);
+      // Horner's rounding on [0, 1] is below about 2R ε Σ|c_r|.
+      const double margin =
+          (8.0 + 2.0 * static_cast<double>(R)) * kEpsilon * (std::abs(c(j, 0)) + std::abs(c1) + rest);
       const bool clear = c(j, 0) > margin && c(j, 0) + c1 - rest > margin &&
                          all_settings.tolerance[j] == 0.0 &&
                          !(all_settings.certified_until[j] > 0.0);
