@@ -43,44 +43,6 @@ std::vector<RowBlock> partition_rows(Index n, Index margin, Index cell) {
   return blocks;
 }
 
-CellRepeats::CellRepeats(const GapStructure& s, Index cell, const std::vector<LoadGroup>& loads) {
-  const Index n = s.dofs();
-  const auto same_column = [&](const SparseMatrix& A, Index i, Index shift) {
-    SparseMatrix::InnerIterator a(A, i), b(A, i - shift);
-    for (; a && b; ++a, ++b) {
-      if (a.row() - i != b.row() - (i - shift) || a.value() != b.value()) return false;
-    }
-    return !a && !b;
-  };
-  const auto fill = [&](Index shift) {
-    differing_.assign(static_cast<std::size_t>(n + 1), 0);
-    for (Index i = 0; i < n; ++i) {
-      bool repeats = i >= shift;
-      for (const SparseMatrix* A : {&s.mass, &s.damping, &s.stiffness}) {
-        repeats = repeats && same_column(*A, i, shift);
-      }
-      for (const LoadGroup& g : loads) {
-        repeats = repeats && g.sin_part[i] == g.sin_part[i - shift] &&
-                  g.cos_part[i] == g.cos_part[i - shift];
-      }
-      differing_[static_cast<std::size_t>(i + 1)] =
-          differing_[static_cast<std::size_t>(i)] + (repeats ? 0 : 1);
-    }
-  };
-  if (cell <= 0) return;  // no cell: nothing repeats
-  const Index lo = n / 4, hi = n - n / 4;
-  for (Index k = 1; k <= 8; ++k) {
-    shift_ = k * cell;
-    if (hi - lo < 2 * shift_) break;
-    fill(shift_);
-    if (differing_[static_cast<std::size_t>(hi)] == differing_[static_cast<std::size_t>(lo + shift_)]) {
-      return;
-    }
-  }
-  shift_ = cell;
-  fill(shift_);
-}
-
 }  // namespace banded_detail
 
 Vector interleave_state(const Vector& x, const Vector& v) {

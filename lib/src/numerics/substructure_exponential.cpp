@@ -5,6 +5,8 @@
 // the precise integration method of Zhong & Williams (1994).
 #include "pwl/numerics/substructure_exponential.hpp"
 
+#include "numerics/row_blocks.hpp"
+
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -161,5 +163,41 @@ Index detect_cell_size(const GapStructure& structure, Index max_cell) {
   }
   return 0;
 }
+
+namespace banded_detail {
+
+// The windows that repeat, by the same column comparison as detect_cell_size (row_blocks.hpp).
+CellRepeats::CellRepeats(const GapStructure& s, Index cell, const std::vector<LoadGroup>& loads) {
+  const Index n = s.dofs();
+  const auto fill = [&](Index shift) {
+    differing_.assign(static_cast<std::size_t>(n + 1), 0);
+    for (Index i = 0; i < n; ++i) {
+      bool repeats = i >= shift;
+      for (const SparseMatrix* A : {&s.mass, &s.damping, &s.stiffness}) {
+        repeats = repeats && shifted_column_matches(*A, i - shift, shift);
+      }
+      for (const LoadGroup& g : loads) {
+        repeats = repeats && g.sin_part[i] == g.sin_part[i - shift] &&
+                  g.cos_part[i] == g.cos_part[i - shift];
+      }
+      differing_[static_cast<std::size_t>(i + 1)] =
+          differing_[static_cast<std::size_t>(i)] + (repeats ? 0 : 1);
+    }
+  };
+  if (cell <= 0) return;  // no cell: nothing repeats
+  const Index lo = n / 4, hi = n - n / 4;
+  for (Index k = 1; k <= 8; ++k) {
+    shift_ = k * cell;
+    if (hi - lo < 2 * shift_) break;
+    fill(shift_);
+    if (differing_[static_cast<std::size_t>(hi)] == differing_[static_cast<std::size_t>(lo + shift_)]) {
+      return;
+    }
+  }
+  shift_ = cell;
+  fill(shift_);
+}
+
+}  // namespace banded_detail
 
 }  // namespace pwl

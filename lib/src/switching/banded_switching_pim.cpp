@@ -401,9 +401,7 @@ class BandedStepper final : public SwitchingPim,
         if (r == last) break;
         const double f = eta_ / (r + 1);
         if (r < d_) {
-          band_product(stiffness_band_, t_x_, t_acc_);
-          damping_band_.multiply_add(t_u_.data(), t_acc_.data());
-          if (!start_acting_.empty()) force_band_.multiply_add(t_p_.data(), t_acc_.data());
+          accelerate(t_x_, t_u_, t_p_, !start_acting_.empty(), t_acc_);
         }
         t_x_ = f * t_u_;
         if (r < d_) t_u_ = f * t_acc_;
@@ -492,12 +490,17 @@ class BandedStepper final : public SwitchingPim,
   }
 
   // The hooks of ModeSeries (switching_pim_detail.hpp), which holds the Taylor recursion and the
-  // pieces of switching steps, here with sparse products; xs_[0] and us_[0] hold the start.
+  // pieces of switching steps, here with banded products; xs_[0] and us_[0] hold the start.
   void gap_product(const Vector& x, Vector& out) const { band_product(gap_band_, x, out); }
   void acceleration(const Vector& x, const Vector& u, const Vector& p, Vector& acc) const {
+    accelerate(x, u, p, !acting_.empty(), acc);
+  }
+  // acc = -M⁻¹ (K x + C u), plus -M⁻¹ W p when springs act.
+  void accelerate(const Vector& x, const Vector& u, const Vector& p, bool forces,
+                  Vector& acc) const {
     band_product(stiffness_band_, x, acc);
     damping_band_.multiply_add(u.data(), acc.data());
-    if (!acting_.empty()) force_band_.multiply_add(p.data(), acc.data());
+    if (forces) force_band_.multiply_add(p.data(), acc.data());
   }
   // out = A x (out resized; it must not be x).
   static void band_product(const BandedMatrix& A, const Vector& x, Vector& out) {

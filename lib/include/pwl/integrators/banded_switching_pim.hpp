@@ -22,9 +22,11 @@
 // I - K2 W^T Φ_x is banded and goes to the banded block-pivoting solver, warm-started from the
 // previous step's active set (banded_lcp_solver.hpp).
 //
-// The rest of the step uses H, W and K2 as sparse matrices: the Taylor recursion that gives the
-// force derivatives p_r (v^{(r+1)} = H v^{(r)} + G P^{(r)} + F^{(r)}) costs O(nnz(H)) = O(n) per
-// term, and the C_r p_r are added from the columns of the touching springs only. A smooth step
+// The rest of the step uses H, W and K2 as narrow banded matrices (their non-zeros; a uniform
+// chain's rows stored once and applied as stencils): the Taylor recursion that gives the force
+// derivatives p_r (v^{(r+1)} = H v^{(r)} + G P^{(r)} + F^{(r)}) costs O(nnz(H)) = O(n) per term,
+// and the C_r p_r are added from the columns of the touching springs only. The searches for
+// switches look only at the springs whose gaps can reach their kinks in the piece. A smooth step
 // therefore costs one banded product T v and d + 1 sparse recursion terms, plus O(contacts · q).
 //
 // Switching steps are redone exactly on the Taylor series of the motion, as in the dense stepper,
