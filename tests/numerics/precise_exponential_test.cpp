@@ -8,6 +8,7 @@
 #include <random>
 
 #include "pwl/errors.hpp"
+#include "pwl/integrators/switching_pim.hpp"
 #include "pwl/numerics/precise_exponential.hpp"
 
 using namespace pwl;
@@ -29,6 +30,17 @@ Matrix random_state_matrix(int n, unsigned seed, double damping) {
 
 double relative_error(const Matrix& a, const Matrix& b) {
   return (a - b).norm() / std::max(1e-300, b.norm());
+}
+
+// Van Loan's block exponential exp([[H, G, 0], [0, 0, I], [0, 0, 0]] η), whose top blocks are
+// ∫ e^{Hu} du G and ∫ e^{H(η-s)} s ds G; the full matrix for T = its top-left block.
+Matrix van_loan_blocks(const Matrix& H, const Matrix& G, double eta) {
+  const Index s = H.rows(), m = G.cols();
+  Matrix A = Matrix::Zero(s + 2 * m, s + 2 * m);
+  A.topLeftCorner(s, s) = H;
+  A.block(0, s, s, m) = G;
+  A.block(s, s + m, m, m).setIdentity();
+  return (A * eta).exp();
 }
 
 }  // namespace
@@ -55,11 +67,7 @@ TEST_CASE("Gamma0 and Gamma1 match Van Loan's block exponential", "[precise_expo
   Matrix G(2 * n, m);
   for (Index i = 0; i < G.size(); ++i) G.data()[i] = normal(rng);
   for (double eta : {0.05, 0.7}) {
-    Matrix A = Matrix::Zero(2 * n + 2 * m, 2 * n + 2 * m);
-    A.topLeftCorner(2 * n, 2 * n) = H;
-    A.block(0, 2 * n, 2 * n, m) = G;
-    A.block(2 * n, 2 * n + m, m, m).setIdentity();
-    const Matrix E = (A * eta).exp();
+    const Matrix E = van_loan_blocks(H, G, eta);
     const Matrix gamma0 = E.block(0, 2 * n, 2 * n, m);
     const Matrix moment = E.block(0, 2 * n + m, 2 * n, m);
     const PreciseExponential p = precise_exponential(H, eta, G, Matrix(2 * n, 0), Vector(0));
@@ -113,6 +121,75 @@ TEST_CASE("Singular H: the integrals need no inverse", "[precise_exponential]") 
   // Γ1 G = ∫ [u²/2... ]: ∫_0^η [u; 1] u du = [η³/3; η²/2].
   CHECK(p.gamma1(0, 0) == Approx(eta * eta * eta / 3).epsilon(1e-14));
   CHECK(p.gamma1(1, 0) == Approx(eta * eta / 2).epsilon(1e-14));
+}
+
+TEST_CASE("Trimmed doublings are exact to rounding, as the paper's N = 20", "[precise_exponential]") {
+  const PreciseExponentialOptions paper;  // the default: always N = 20
+  PreciseExponentialOptions trimmed;
+  trimmed.trim_doublings = true;
+  // How many: ‖Hη‖₁ = 1 at order 4 needs θ = 2^-N <= (5! 2^-53)^(1/4) = 3.4e-4, so N = 12; at
+  // order 8 (9! 2^-53)^(1/8) = 0.050, so N = 5; a tiny H none; a huge one stops at the cap.
+  Matrix unit = Matrix::Zero(2, 2);
+  unit(0, 1) = 1.0;
+  CHECK(doublings_used(unit, 1.0, 0.0, trimmed) == 12);
+  CHECK(doublings_used(unit, 1.0, 0.0, paper) == 20);
+  CHECK(doublings_used(unit, 2.0, 0.0, trimmed) == 13);
+  CHECK(doublings_used(unit, 0.5, 1.5, trimmed) == 12);  // the load frequency counts
+  CHECK(doublings_used(unit, 1e-5, 0.0, trimmed) == 0);
+  CHECK(doublings_used(unit, 1e6, 0.0, trimmed) == 20);
+  PreciseExponentialOptions order8 = trimmed;
+  order8.taylor_order = 8;
+  CHECK(doublings_used(unit, 1.0, 0.0, order8) == 5);
+
+  // The undamped unit oscillator in closed form: exp(Hη) = [[cos η, sin η], [-sin η, cos η]].
+  Matrix oscillator(2, 2);
+  oscillator << 0.0, 1.0, -1.0, 0.0;
+  for (double eta : {1e-4, 0.02, 0.2, 1.0, 3.0}) {
+    const Matrix T = precise_exponential(oscillator, eta, trimmed);
+    INFO("eta = " << eta << ", N = " << doublings_used(oscillator, eta, 0.0, trimmed));
+    CHECK(std::abs(T(0, 0) - std::cos(eta)) < 4e-16);
+    CHECK(std::abs(T(0, 1) - std::sin(eta)) < 4e-16);
+    CHECK(std::abs(T(1, 0) + std::sin(eta)) < 4e-16);
+    CHECK(std::abs(T(1, 1) - std::cos(eta)) < 4e-16);
+  }
+
+  // Every output over ‖Hη‖₁ from 1e-3 to 100: as close to Eigen's Padé exponential (and to Van
+  // Loan's blocks) as the paper's N = 20 is, and the two within rounding of each other.
+  const int n = 4, m = 2;
+  std::mt19937 rng(17);
+  std::normal_distribution<double> normal;
+  Matrix G(2 * n, m);
+  for (Index i = 0; i < G.size(); ++i) G.data()[i] = normal(rng);
+  const Matrix H = random_state_matrix(n, 23u, 0.05);
+  const double norm = H.cwiseAbs().colwise().sum().maxCoeff();
+  for (double size : {1e-3, 0.1, 1.0, 10.0, 100.0}) {
+    const double eta = size / norm;
+    const int N = doublings_used(H, eta, 0.0, trimmed);
+    INFO("||H eta||_1 = " << size << ", N = " << N);
+    CHECK(N < 20);
+    const Matrix E = van_loan_blocks(H, G, eta);
+    const Matrix gamma0 = E.block(0, 2 * n, 2 * n, m);
+    const Matrix gamma1 = eta * gamma0 - E.block(0, 2 * n + m, 2 * n, m);
+    const Matrix none(2 * n, 0);
+    const PreciseExponential a = precise_exponential(H, eta, G, none, Vector(0), trimmed);
+    const PreciseExponential b = precise_exponential(H, eta, G, none, Vector(0), paper);
+    const Matrix expected = E.topLeftCorner(2 * n, 2 * n);
+    const double paper_error = relative_error(b.transition, expected);
+    CHECK(relative_error(a.transition, expected) <= std::max(2.0 * paper_error, 1e-14));
+    CHECK(relative_error(a.transition, b.transition) < 1e-13);
+    CHECK(relative_error(a.gamma0, gamma0) <= std::max(2.0 * relative_error(b.gamma0, gamma0), 1e-14));
+    CHECK(relative_error(a.gamma1, gamma1) <= std::max(2.0 * relative_error(b.gamma1, gamma1), 1e-13));
+    CHECK(relative_error(a.gamma0, b.gamma0) < 1e-13);
+    CHECK(relative_error(a.gamma1, b.gamma1) < 1e-13);
+    // The moments of polynomial forces run the same doublings.
+    const PolynomialForceIntegrals pa = polynomial_force_integrals(H, eta, G, 3, trimmed);
+    const PolynomialForceIntegrals pb = polynomial_force_integrals(H, eta, G, 3, paper);
+    CHECK(relative_error(pa.transition, pb.transition) < 1e-13);
+    CHECK(relative_error(pa.moments[0], gamma0) <= std::max(2.0 * relative_error(pb.moments[0], gamma0), 1e-14));
+    for (std::size_t r = 0; r < pa.moments.size(); ++r) {
+      CHECK(relative_error(pa.moments[r], pb.moments[r]) < 1e-13);
+    }
+  }
 }
 
 TEST_CASE("Bad input to the exponential is named", "[precise_exponential]") {

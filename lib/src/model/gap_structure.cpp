@@ -30,10 +30,12 @@ bool check_matrix(const SparseMatrix& A, const char* name, Index n, std::string*
       largest = std::max(largest, std::abs(it.value()));
     }
   }
-  const SparseMatrix asym = A - SparseMatrix(A.transpose());
-  for (Index j = 0; j < asym.outerSize(); ++j) {
-    for (SparseMatrix::InnerIterator it(asym, j); it; ++it) {
-      if (std::abs(it.value()) > 1e-12 * std::max(1.0, largest)) {
+  // Each off-diagonal entry against its mirror, found by a search in the mirror's column: no
+  // transpose is formed.
+  for (Index j = 0; j < A.outerSize(); ++j) {
+    for (SparseMatrix::InnerIterator it(A, j); it; ++it) {
+      if (it.row() == j) continue;
+      if (std::abs(it.value() - A.coeff(j, it.row())) > 1e-12 * std::max(1.0, largest)) {
         *why = fmt::format("{} is not symmetric: {}[{},{}] = {} but {}[{},{}] = {}", name, name,
                            it.row(), it.col(), A.coeff(it.row(), it.col()), name, it.col(),
                            it.row(), A.coeff(it.col(), it.row()));
@@ -43,6 +45,9 @@ bool check_matrix(const SparseMatrix& A, const char* name, Index n, std::string*
   }
   return true;
 }
+
+// Up to this bandwidth the LDL^T below keeps the natural order.
+constexpr Index kNaturalOrderBandwidth = 64;
 
 // Whether a symmetric matrix is positive (semi)definite, by a sparse LDL^T. A semidefinite
 // check allows pivots down to -tol * scale (a free-free stiffness matrix has zero pivots).
@@ -60,13 +65,34 @@ bool check_definite(const SparseMatrix& A, const char* name, const char* quantit
     if (strict) *why = fmt::format("{} is zero: {} must be positive", name, quantity);
     return !strict;
   }
-  Eigen::SimplicialLDLT<SparseMatrix> ldlt(A);
-  if (ldlt.info() != Eigen::Success) {
+  // A chain's matrices are narrow bands, which the natural order factorises without fill: the
+  // fill-reducing ordering (AMD) would cost more than the factorisation itself.
+  Index bandwidth = 0;
+  for (Index j = 0; j < A.outerSize(); ++j) {
+    for (SparseMatrix::InnerIterator it(A, j); it; ++it) {
+      bandwidth = std::max<Index>(bandwidth, std::abs(it.row() - j));
+    }
+  }
+  const auto pivots = [&](auto& ldlt, Vector& d) {
+    ldlt.compute(A);
+    if (ldlt.info() != Eigen::Success) return false;
+    d = ldlt.vectorD();
+    return true;
+  };
+  Vector d;
+  bool factorised = false;
+  if (bandwidth <= kNaturalOrderBandwidth) {
+    Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::NaturalOrdering<int>> ldlt;
+    factorised = pivots(ldlt, d);
+  } else {
+    Eigen::SimplicialLDLT<SparseMatrix> ldlt;
+    factorised = pivots(ldlt, d);
+  }
+  if (!factorised) {
     if (!strict) return true;  // a singular semidefinite matrix may stop the factorisation
     *why = fmt::format("{} is not positive definite (its factorisation failed)", name);
     return false;
   }
-  const Vector d = ldlt.vectorD();
   const double scale = std::max(1e-300, d.cwiseAbs().maxCoeff());
   for (Index i = 0; i < d.size(); ++i) {
     if (strict ? d[i] <= 1e-14 * scale : d[i] < -1e-10 * scale) {

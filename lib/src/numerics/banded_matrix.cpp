@@ -727,7 +727,10 @@ BandedMatrix transpose(const BandedMatrix& A) {
       b.set_row(j, 0, row.data(), 0);
       continue;
     }
-    for (Index i = l; i <= h; ++i) row[static_cast<std::size_t>(i - l)] = A.coeff(i, j);
+    for (Index i = l; i <= h; ++i) {
+      const Index k = j - A.first_column(i);
+      row[static_cast<std::size_t>(i - l)] = k >= 0 && k < w ? A.row_values(i)[k] : 0.0;
+    }
     b.set_row(j, l, row.data(), h - l + 1);
   }
   return b.build();

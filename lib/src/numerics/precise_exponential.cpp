@@ -24,6 +24,20 @@ bool PreciseExponentialOptions::is_valid(std::string* why) const {
   return true;
 }
 
+int doublings_used(const Matrix& H, double eta, double frequency,
+                   const PreciseExponentialOptions& options) {
+  if (!options.trim_doublings) return options.doublings;
+  const int p = options.taylor_order;
+  double factorial = 1.0;  // (p + 1)!
+  for (int k = 2; k <= p + 1; ++k) factorial *= k;
+  const double theta_max = std::pow(factorial * std::ldexp(1.0, -53), 1.0 / p);
+  const double norm = H.size() > 0 ? H.cwiseAbs().colwise().sum().maxCoeff() : 0.0;
+  const double theta = (norm + std::abs(frequency)) * eta;
+  int N = 0;
+  while (N < options.doublings && std::ldexp(theta, -N) > theta_max) ++N;
+  return N;
+}
+
 namespace {
 
 void check_finite(const Matrix& A, const char* name) {
@@ -60,7 +74,9 @@ PreciseExponential precise_exponential(const Matrix& H, double eta, const Matrix
 
   const Index m = G.cols();
   const Index h = B.cols();
-  double tau = std::ldexp(eta, -options.doublings);
+  const int doublings =
+      doublings_used(H, eta, h > 0 ? omegas.cwiseAbs().maxCoeff() : 0.0, options);
+  double tau = std::ldexp(eta, -doublings);
 
   // Taylor series at τ. The thin blocks are built from the columns up: H^k G, and for the
   // harmonic columns v_j = Σ_{k+l=j} H^k (iω)^l b, so that Kω(τ) = Σ_j τ^{j+1}/(j+1)! v_j.
@@ -92,7 +108,7 @@ PreciseExponential precise_exponential(const Matrix& H, double eta, const Matrix
 
   // Doublings. All thin blocks use the values at τ before T_a itself is doubled.
   Matrix thin(n, 2 * m + 2 * h);
-  for (int d = 0; d < options.doublings; ++d) {
+  for (int d = 0; d < doublings; ++d) {
     thin.leftCols(m) = g0;
     thin.middleCols(m, m) = g1 + tau * g0;
     thin.middleCols(2 * m, h) = kw.real();

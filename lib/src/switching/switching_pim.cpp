@@ -64,7 +64,8 @@ PolynomialForceIntegrals polynomial_force_integrals(const Matrix& H, double eta,
   const Index n = H.rows();
   const Index m = G.cols();
   const int count = degree + 1;
-  double tau = std::ldexp(eta, -options.doublings);
+  const int doublings = doublings_used(H, eta, 0.0, options);
+  double tau = std::ldexp(eta, -doublings);
 
   // Taylor series at τ: T_a = Σ_{k>=1} (Hτ)^k/k!, Ξ̂_r = Σ_k H^k G τ^{k+1} r!/(k+r+1)!.
   Matrix Ta = Matrix::Zero(n, n);
@@ -95,7 +96,7 @@ PolynomialForceIntegrals polynomial_force_integrals(const Matrix& H, double eta,
     }
   }
   Matrix stacked(n, count * m);
-  for (int d = 0; d < options.doublings; ++d) {
+  for (int d = 0; d < doublings; ++d) {
     for (int r = 0; r < count; ++r) stacked.middleCols(r * m, m) = moments[static_cast<std::size_t>(r)];
     const Matrix TaX = Ta * stacked;
     std::vector<Matrix> next(static_cast<std::size_t>(count));

@@ -24,10 +24,26 @@
 namespace pwl {
 
 struct PreciseExponentialOptions {
-  int doublings = 20;    // N: the Taylor series starts at τ = η / 2^N
+  int doublings = 20;    // N at most: the Taylor series starts at τ = η / 2^N
   int taylor_order = 4;  // terms of the series at τ (the paper's 4 is exact to rounding for N = 20)
+  // Run fewer doublings where a larger τ is already exact to rounding (doublings_used below):
+  // N = 20 is what the paper takes for any H, and for a moderate ‖Hη‖ half of those doublings
+  // only shrink a remainder that is already below the unit roundoff. Off by default, so that the
+  // dense PIM's motion is the paper's N = 20 to the bit (a chaotic motion, and every figure made
+  // from one, changes with the last bit of T). The banded exponential turns it on for its
+  // substructures (banded_exponential.hpp), whose construction is the cost being cut.
+  bool trim_doublings = false;
   bool is_valid(std::string* why) const;
 };
+
+// The doublings the 2^N algorithm runs for H, η and load frequencies up to `frequency`: with
+// trim_doublings, the fewest N <= options.doublings at which θ = (‖H‖₁ + frequency) η / 2^N
+// makes the series' remainder relative to the increment, θ^p / (p+1)! for order p, no larger
+// than the unit roundoff 2^-53 (p = 4: θ <= 3.4e-4, so ‖Hη‖₁ = 1 takes N = 12). A series whose
+// θ is that small is exact to rounding, as N = 20 is for ‖Hη‖₁ up to about 350; beyond that N
+// stays at options.doublings, as before. Without trim_doublings: options.doublings.
+int doublings_used(const Matrix& H, double eta, double frequency,
+                   const PreciseExponentialOptions& options);
 
 struct PreciseExponential {
   Matrix transition;        // T = exp(Hη)
