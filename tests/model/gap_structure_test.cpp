@@ -126,6 +126,55 @@ TEST_CASE("Validation names the field and the value", "[structure]") {
   free << 1, -1, -1, 1;
   s.stiffness = to_sparse(free);
   CHECK(s.is_valid(nullptr));
+  // An indefinite stiffness whose LDL^T stops at its first (zero) pivot is not semidefinite.
+  s = two_masses();
+  Matrix swap(2, 2);
+  swap << 0, 1, 1, 0;
+  s.stiffness = to_sparse(swap);
+  CHECK_THAT(why_invalid(s), Catch::Contains("stiffness is not positive semidefinite"));
+  // Zero damping with its zeros stored is semidefinite.
+  s = two_masses();
+  s.damping = to_sparse(Matrix::Zero(2, 2));
+  for (Index i = 0; i < 2; ++i) {
+    for (Index j = 0; j < 2; ++j) s.damping.coeffRef(i, j) = 0.0;
+  }
+  REQUIRE(s.damping.nonZeros() == 4);
+  CHECK(s.is_valid(nullptr));
+  s.stiffness = to_sparse(Matrix::Zero(2, 2));
+  s.damping = to_sparse(swap);
+  CHECK_THAT(why_invalid(s), Catch::Contains("damping is not positive semidefinite"));
+}
+
+TEST_CASE("Definiteness of wide and narrow bands", "[structure]") {
+  // A ring of 100 masses (a coupling from the last to the first: bandwidth 99, factorised in a
+  // fill-reducing order) and the same chain open (bandwidth 1, natural order): free-free and
+  // grounded, valid; with one coupling entry too large for its diagonal, not.
+  for (bool ring : {false, true}) {
+    const int n = 100;
+    Matrix K = Matrix::Zero(n, n);
+    const auto couple = [&](int i, int j, double k) {
+      K(i, i) += k;
+      K(j, j) += k;
+      K(i, j) -= k;
+      K(j, i) -= k;
+    };
+    for (int i = 0; i + 1 < n; ++i) couple(i, i + 1, 1.0);
+    if (ring) couple(n - 1, 0, 1.0);
+    GapStructure s;
+    s.mass = to_sparse(Matrix::Identity(n, n));
+    s.damping = to_sparse(Matrix::Zero(n, n));
+    s.stiffness = to_sparse(K);
+    INFO((ring ? "ring" : "open chain"));
+    CHECK(s.is_valid(nullptr));  // free-free: semidefinite
+    K(0, 0) += 2.0;               // grounded at mass 0
+    s.stiffness = to_sparse(K);
+    CHECK(s.is_valid(nullptr));
+    // A coupling entry too large for its diagonal: [[2, -5], [-5, 2]] has an eigenvalue -3.
+    K(n / 2, n / 2 + 1) = K(n / 2 + 1, n / 2) = -5.0;
+    s.stiffness = to_sparse(K);
+    const std::string why = why_invalid(s);
+    CHECK_THAT(why, Catch::Contains("stiffness is not positive semidefinite"));
+  }
 }
 
 TEST_CASE("The paper's chains", "[structure]") {

@@ -43,6 +43,18 @@ Matrix van_loan_blocks(const Matrix& H, const Matrix& G, double eta) {
   return (A * eta).exp();
 }
 
+// exp([[H, b, 0], [0, 0, -ω], [0, ω, 0]] η): the column fed by w(0) = (1, 0) is
+// ∫ e^{H(η-s)} b cos ωs ds = Re K b, the one fed by (0, 1) is -∫ e^{H(η-s)} b sin ωs ds = -Im K b.
+Matrix van_loan_harmonic(const Matrix& H, const Vector& b, double omega, double eta) {
+  const Index s = H.rows();
+  Matrix A = Matrix::Zero(s + 2, s + 2);
+  A.topLeftCorner(s, s) = H;
+  A.block(0, s, s, 1) = b;
+  A(s, s + 1) = -omega;
+  A(s + 1, s) = omega;
+  return (A * eta).exp();
+}
+
 }  // namespace
 
 TEST_CASE("2^N exponential matches Eigen's Pade exponential", "[precise_exponential]") {
@@ -78,8 +90,7 @@ TEST_CASE("Gamma0 and Gamma1 match Van Loan's block exponential", "[precise_expo
 }
 
 TEST_CASE("Harmonic load integrals match Van Loan's block exponential", "[precise_exponential]") {
-  // exp([[H, b, 0], [0, 0, -ω], [0, ω, 0]] η): the column fed by w(0) = (1, 0) is
-  // ∫ e^{H(η-s)} b cos ωs ds = Re K b, the one fed by (0, 1) is -∫ e^{H(η-s)} b sin ωs ds = -Im K b.
+  // Van Loan's harmonic blocks (van_loan_harmonic).
   const int n = 3;
   for (double damping : {0.0, 0.2}) {
     const Matrix H = random_state_matrix(n, 3u, damping);
@@ -87,12 +98,7 @@ TEST_CASE("Harmonic load integrals match Van Loan's block exponential", "[precis
     b.tail(n) << 1.0, -2.0, 0.5;
     for (double omega : {0.0, 0.8, 3.0}) {
       const double eta = 0.4;
-      Matrix A = Matrix::Zero(2 * n + 2, 2 * n + 2);
-      A.topLeftCorner(2 * n, 2 * n) = H;
-      A.block(0, 2 * n, 2 * n, 1) = b;
-      A(2 * n, 2 * n + 1) = -omega;
-      A(2 * n + 1, 2 * n) = omega;
-      const Matrix E = (A * eta).exp();
+      const Matrix E = van_loan_harmonic(H, b, omega, eta);
       Vector w(1);
       w << omega;
       const PreciseExponential p = precise_exponential(H, eta, Matrix(2 * n, 0), b, w);
@@ -140,54 +146,83 @@ TEST_CASE("Trimmed doublings are exact to rounding, as the paper's N = 20", "[pr
   PreciseExponentialOptions order8 = trimmed;
   order8.taylor_order = 8;
   CHECK(doublings_used(unit, 1.0, 0.0, order8) == 5);
+  // Long series stop at θ = 1/2 ((17! 2^-53)^(1/16) = 0.82 would allow 0.7).
+  PreciseExponentialOptions order16 = trimmed;
+  order16.taylor_order = 16;
+  CHECK(doublings_used(unit, 0.7, 0.0, order16) == 1);
+  // The larger of the column and row sums (row sum 4, column sums 1, and transposed): with one
+  // of them alone, θ = 1/4 would take N = 10.
+  Matrix lopsided = Matrix::Zero(5, 5);
+  lopsided.row(0).tail(4).setOnes();
+  CHECK(doublings_used(lopsided, 0.25, 0.0, trimmed) == 12);
+  CHECK(doublings_used(lopsided.transpose(), 0.25, 0.0, trimmed) == 12);
 
   // The undamped unit oscillator in closed form: exp(Hη) = [[cos η, sin η], [-sin η, cos η]].
   Matrix oscillator(2, 2);
   oscillator << 0.0, 1.0, -1.0, 0.0;
-  for (double eta : {1e-4, 0.02, 0.2, 1.0, 3.0}) {
-    const Matrix T = precise_exponential(oscillator, eta, trimmed);
-    INFO("eta = " << eta << ", N = " << doublings_used(oscillator, eta, 0.0, trimmed));
-    CHECK(std::abs(T(0, 0) - std::cos(eta)) < 4e-16);
-    CHECK(std::abs(T(0, 1) - std::sin(eta)) < 4e-16);
-    CHECK(std::abs(T(1, 0) + std::sin(eta)) < 4e-16);
-    CHECK(std::abs(T(1, 1) - std::cos(eta)) < 4e-16);
+  for (const PreciseExponentialOptions& o : {trimmed, order8}) {
+    for (double eta : {1e-4, 0.02, 0.2, 1.0, 3.0}) {
+      const Matrix T = precise_exponential(oscillator, eta, o);
+      INFO("order " << o.taylor_order << ", eta = " << eta
+                    << ", N = " << doublings_used(oscillator, eta, 0.0, o));
+      CHECK(std::abs(T(0, 0) - std::cos(eta)) < 4e-16);
+      CHECK(std::abs(T(0, 1) - std::sin(eta)) < 4e-16);
+      CHECK(std::abs(T(1, 0) + std::sin(eta)) < 4e-16);
+      CHECK(std::abs(T(1, 1) - std::cos(eta)) < 4e-16);
+    }
   }
 
-  // Every output over ‖Hη‖₁ from 1e-3 to 100: as close to Eigen's Padé exponential (and to Van
-  // Loan's blocks) as the paper's N = 20 is, and the two within rounding of each other.
+  // Every output over ‖Hη‖ from 1e-3 to 100, at orders 4 and 8: as close to Eigen's Padé
+  // exponential (and to Van Loan's blocks) as the paper's N = 20 is, the two within rounding of
+  // each other, and not the same bits (the trimmed run did run fewer doublings).
   const int n = 4, m = 2;
   std::mt19937 rng(17);
   std::normal_distribution<double> normal;
   Matrix G(2 * n, m);
   for (Index i = 0; i < G.size(); ++i) G.data()[i] = normal(rng);
+  Vector b = Vector::Zero(2 * n);
+  b.tail(n) << 1.0, -2.0, 0.5, 0.7;
   const Matrix H = random_state_matrix(n, 23u, 0.05);
-  const double norm = H.cwiseAbs().colwise().sum().maxCoeff();
-  for (double size : {1e-3, 0.1, 1.0, 10.0, 100.0}) {
-    const double eta = size / norm;
-    const int N = doublings_used(H, eta, 0.0, trimmed);
-    INFO("||H eta||_1 = " << size << ", N = " << N);
-    CHECK(N < 20);
-    const Matrix E = van_loan_blocks(H, G, eta);
-    const Matrix gamma0 = E.block(0, 2 * n, 2 * n, m);
-    const Matrix gamma1 = eta * gamma0 - E.block(0, 2 * n + m, 2 * n, m);
-    const Matrix none(2 * n, 0);
-    const PreciseExponential a = precise_exponential(H, eta, G, none, Vector(0), trimmed);
-    const PreciseExponential b = precise_exponential(H, eta, G, none, Vector(0), paper);
-    const Matrix expected = E.topLeftCorner(2 * n, 2 * n);
-    const double paper_error = relative_error(b.transition, expected);
-    CHECK(relative_error(a.transition, expected) <= std::max(2.0 * paper_error, 1e-14));
-    CHECK(relative_error(a.transition, b.transition) < 1e-13);
-    CHECK(relative_error(a.gamma0, gamma0) <= std::max(2.0 * relative_error(b.gamma0, gamma0), 1e-14));
-    CHECK(relative_error(a.gamma1, gamma1) <= std::max(2.0 * relative_error(b.gamma1, gamma1), 1e-13));
-    CHECK(relative_error(a.gamma0, b.gamma0) < 1e-13);
-    CHECK(relative_error(a.gamma1, b.gamma1) < 1e-13);
-    // The moments of polynomial forces run the same doublings.
-    const PolynomialForceIntegrals pa = polynomial_force_integrals(H, eta, G, 3, trimmed);
-    const PolynomialForceIntegrals pb = polynomial_force_integrals(H, eta, G, 3, paper);
-    CHECK(relative_error(pa.transition, pb.transition) < 1e-13);
-    CHECK(relative_error(pa.moments[0], gamma0) <= std::max(2.0 * relative_error(pb.moments[0], gamma0), 1e-14));
-    for (std::size_t r = 0; r < pa.moments.size(); ++r) {
-      CHECK(relative_error(pa.moments[r], pb.moments[r]) < 1e-13);
+  const double norm = std::max(H.cwiseAbs().colwise().sum().maxCoeff(),
+                               H.cwiseAbs().rowwise().sum().maxCoeff());
+  for (const PreciseExponentialOptions& o : {trimmed, order8}) {
+    for (double size : {1e-3, 0.1, 1.0, 10.0, 100.0}) {
+      const double eta = size / norm;
+      const double omega = 3.0 / eta;  // |ω|η = 3, beside ‖Hη‖
+      Vector omegas(1);
+      omegas << omega;
+      const int N = doublings_used(H, eta, omega, o);
+      INFO("order " << o.taylor_order << ", ||H eta|| = " << size << ", N = " << N);
+      CHECK(N < 20);
+      const Matrix E = van_loan_blocks(H, G, eta);
+      const Matrix gamma0 = E.block(0, 2 * n, 2 * n, m);
+      const Matrix gamma1 = eta * gamma0 - E.block(0, 2 * n + m, 2 * n, m);
+      const Matrix harmonic = van_loan_harmonic(H, b, omega, eta);
+      const PreciseExponential a = precise_exponential(H, eta, G, b, omegas, o);
+      const PreciseExponential p = precise_exponential(H, eta, G, b, omegas, paper);
+      const auto as_close = [](const Matrix& got, const Matrix& paper_got, const Matrix& truth) {
+        return relative_error(got, truth) <= std::max(2.0 * relative_error(paper_got, truth), 2e-14);
+      };
+      CHECK(as_close(a.transition, p.transition, E.topLeftCorner(2 * n, 2 * n)));
+      CHECK(as_close(a.gamma0, p.gamma0, gamma0));
+      CHECK(as_close(a.gamma1, p.gamma1, gamma1));
+      CHECK(as_close(a.harmonic_real, p.harmonic_real, harmonic.block(0, 2 * n, 2 * n, 1)));
+      CHECK(as_close(a.harmonic_imag, p.harmonic_imag, -harmonic.block(0, 2 * n + 1, 2 * n, 1)));
+      CHECK(relative_error(a.transition, p.transition) < 1e-13);
+      CHECK(relative_error(a.gamma0, p.gamma0) < 1e-13);
+      CHECK(relative_error(a.gamma1, p.gamma1) < 1e-13);
+      CHECK(relative_error(a.harmonic_real, p.harmonic_real) < 1e-13);
+      CHECK(relative_error(a.harmonic_imag, p.harmonic_imag) < 1e-13);
+      CHECK(a.transition != p.transition);
+      // The moments of polynomial forces run the same doublings (no load frequency).
+      const PolynomialForceIntegrals pa = polynomial_force_integrals(H, eta, G, 3, o);
+      const PolynomialForceIntegrals pb = polynomial_force_integrals(H, eta, G, 3, paper);
+      CHECK(doublings_used(H, eta, 0.0, o) <= N);
+      CHECK(relative_error(pa.transition, pb.transition) < 1e-13);
+      CHECK(as_close(pa.moments[0], pb.moments[0], gamma0));
+      for (std::size_t r = 0; r < pa.moments.size(); ++r) {
+        CHECK(relative_error(pa.moments[r], pb.moments[r]) < 1e-13);
+      }
     }
   }
 }

@@ -130,7 +130,9 @@ std::unique_ptr<Integrator> make_pim_integrator_auto(const GapStructure& structu
   if (structure.dofs() > banded_above && banded_layout(structure).banded) {
     BandedPimOptions b;
     b.step = options.step;
-    b.band.exponential = options.exponential;
+    // The most doublings carry over; the substructures keep their own series and trimming
+    // (banded_exponential.hpp), so `pim` and `pim-banded` are the same stepper on a long chain.
+    b.band.exponential.doublings = options.exponential.doublings;
     b.divergence_bound = options.divergence_bound;
     return make_banded_pim_integrator(structure, b);
   }

@@ -73,25 +73,42 @@ bool check_definite(const SparseMatrix& A, const char* name, const char* quantit
       bandwidth = std::max<Index>(bandwidth, std::abs(it.row() - j));
     }
   }
-  const auto pivots = [&](auto& ldlt, Vector& d) {
-    ldlt.compute(A);
-    if (ldlt.info() != Eigen::Success) return false;
-    d = ldlt.vectorD();
-    return true;
+  // The pivots of B's LDL^T; false when the factorisation stops (a zero pivot).
+  const auto pivots = [&](const SparseMatrix& B, Vector& d) {
+    const auto factor = [&](auto& ldlt) {
+      ldlt.compute(B);
+      if (ldlt.info() != Eigen::Success) return false;
+      d = ldlt.vectorD();
+      return true;
+    };
+    if (bandwidth <= kNaturalOrderBandwidth) {
+      Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::NaturalOrdering<int>> ldlt;
+      return factor(ldlt);
+    }
+    Eigen::SimplicialLDLT<SparseMatrix> ldlt;
+    return factor(ldlt);
   };
   Vector d;
-  bool factorised = false;
-  if (bandwidth <= kNaturalOrderBandwidth) {
-    Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::NaturalOrdering<int>> ldlt;
-    factorised = pivots(ldlt, d);
-  } else {
-    Eigen::SimplicialLDLT<SparseMatrix> ldlt;
-    factorised = pivots(ldlt, d);
-  }
-  if (!factorised) {
-    if (!strict) return true;  // a singular semidefinite matrix may stop the factorisation
-    *why = fmt::format("{} is not positive definite (its factorisation failed)", name);
-    return false;
+  if (!pivots(A, d)) {
+    if (strict) {
+      *why = fmt::format("{} is not positive definite (its factorisation failed)", name);
+      return false;
+    }
+    // A singular semidefinite matrix (a free-free stiffness) stops the factorisation at a zero
+    // pivot. Shifted by a small multiple of its largest entry it is definite; an indefinite one
+    // (whose negative eigenvalue is larger than the shift) is not.
+    const double largest = A.coeffs().cwiseAbs().maxCoeff();
+    if (largest == 0.0) return true;  // zeros stored explicitly: the zero matrix
+    const double shift = 1e-10 * largest;
+    SparseMatrix shifted = A;
+    for (Index i = 0; i < A.rows(); ++i) shifted.coeffRef(i, i) += shift;
+    if (!pivots(shifted, d) || !(d.minCoeff() > 0.0)) {
+      *why = fmt::format("{} is not positive semidefinite: its LDL^T stops at a zero pivot, and "
+                         "shifted by {:.3g} I it is still not definite",
+                         name, shift);
+      return false;
+    }
+    return true;
   }
   const double scale = std::max(1e-300, d.cwiseAbs().maxCoeff());
   for (Index i = 0; i < d.size(); ++i) {

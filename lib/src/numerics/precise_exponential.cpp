@@ -30,8 +30,13 @@ int doublings_used(const Matrix& H, double eta, double frequency,
   const int p = options.taylor_order;
   double factorial = 1.0;  // (p + 1)!
   for (int k = 2; k <= p + 1; ++k) factorial *= k;
-  const double theta_max = std::pow(factorial * std::ldexp(1.0, -53), 1.0 / p);
-  const double norm = H.size() > 0 ? H.cwiseAbs().colwise().sum().maxCoeff() : 0.0;
+  // Beyond θ = 1/2 (orders above 10) the increment is no longer about θ in size and the series
+  // itself loses digits to cancellation: the bound stops there.
+  const double theta_max = std::min(0.5, std::pow(factorial * std::ldexp(1.0, -53), 1.0 / p));
+  // The larger of the 1- and ∞-norms (column and row sums differ when the masses do).
+  const double norm = H.size() > 0 ? std::max(H.cwiseAbs().colwise().sum().maxCoeff(),
+                                              H.cwiseAbs().rowwise().sum().maxCoeff())
+                                   : 0.0;
   const double theta = (norm + std::abs(frequency)) * eta;
   int N = 0;
   while (N < options.doublings && std::ldexp(theta, -N) > theta_max) ++N;

@@ -47,8 +47,10 @@ std::unique_ptr<Integrator> make_banded_pim_integrator(const GapStructure& struc
 
 // Dense or banded by size: the banded stepper when the structure has more than banded_above
 // degrees of freedom and banded_layout says it is banded, the dense one otherwise. The step,
-// exponential options and divergence bound come from `options`; its lcp_solver applies to the
-// dense stepper only (the banded one uses BandedLcpSolver).
+// the divergence bound and the most doublings come from `options`; the banded stepper keeps its
+// substructures' own series order and trimmed doublings (BandedExponentialOptions), so that it is
+// the stepper make_banded_pim_integrator gives. `options`' lcp_solver applies to the dense stepper
+// only (the banded one uses BandedLcpSolver).
 std::unique_ptr<Integrator> make_pim_integrator_auto(const GapStructure& structure,
                                                      const PimOptions& options,
                                                      Index banded_above = 50);

@@ -37,11 +37,14 @@ struct PreciseExponentialOptions {
 };
 
 // The doublings the 2^N algorithm runs for H, η and load frequencies up to `frequency`: with
-// trim_doublings, the fewest N <= options.doublings at which θ = (‖H‖₁ + frequency) η / 2^N
-// makes the series' remainder relative to the increment, θ^p / (p+1)! for order p, no larger
-// than the unit roundoff 2^-53 (p = 4: θ <= 3.4e-4, so ‖Hη‖₁ = 1 takes N = 12). A series whose
-// θ is that small is exact to rounding, as N = 20 is for ‖Hη‖₁ up to about 350; beyond that N
-// stays at options.doublings, as before. Without trim_doublings: options.doublings.
+// trim_doublings, the fewest N <= options.doublings at which θ = (‖H‖ + frequency) η / 2^N
+// (‖H‖ the larger of the 1- and ∞-norms) makes the series' remainder relative to the increment,
+// θ^p / (p+1)! for order p, no larger than the unit roundoff 2^-53 (p = 4: θ <= 3.4e-4, so
+// ‖Hη‖ = 1 takes N = 12; p = 8: θ <= 0.050, N = 5), and θ <= 1/2. The load integrals' series
+// converge at least as fast (their k-th terms carry 1/(k+1)! or less, and the harmonic ones
+// (‖H‖ + |ω|)^k). A series whose θ is that small is exact to rounding, as the paper's N = 20 of
+// order 4 is for ‖Hη‖ up to about 350; beyond the cap N stays at options.doublings, as before.
+// Without trim_doublings: options.doublings.
 int doublings_used(const Matrix& H, double eta, double frequency,
                    const PreciseExponentialOptions& options);
 
