@@ -24,6 +24,12 @@ GapStructure two_masses() {
   return s;
 }
 
+SparseMatrix symmetric_2x2(double diagonal0, double off_diagonal, double diagonal1) {
+  Matrix A(2, 2);
+  A << diagonal0, off_diagonal, off_diagonal, diagonal1;
+  return to_sparse(A);
+}
+
 std::string why_invalid(const GapStructure& s) {
   std::string why;
   CHECK_FALSE(s.is_valid(&why));
@@ -100,9 +106,7 @@ TEST_CASE("Validation names the field and the value", "[structure]") {
   s.stiffness = to_sparse(Matrix::Identity(3, 3));
   CHECK_THAT(why_invalid(s), Catch::Contains("stiffness is 3x3, expected 2x2"));
   s = two_masses();
-  Matrix indefinite(2, 2);
-  indefinite << 1, 2, 2, 1;
-  s.stiffness = to_sparse(indefinite);
+  s.stiffness = symmetric_2x2(1, 2, 1);
   CHECK_THAT(why_invalid(s), Catch::Contains("not positive semidefinite"));
   s = two_masses();
   s.springs[1].stiffness = -1.0;
@@ -122,15 +126,11 @@ TEST_CASE("Validation names the field and the value", "[structure]") {
   CHECK_THROWS_AS(s.validate(), InputError);
   // A free-free stiffness is semidefinite and valid.
   s = two_masses();
-  Matrix free(2, 2);
-  free << 1, -1, -1, 1;
-  s.stiffness = to_sparse(free);
+  s.stiffness = symmetric_2x2(1, -1, 1);
   CHECK(s.is_valid(nullptr));
   // An indefinite stiffness whose LDL^T stops at its first (zero) pivot is not semidefinite.
   s = two_masses();
-  Matrix swap(2, 2);
-  swap << 0, 1, 1, 0;
-  s.stiffness = to_sparse(swap);
+  s.stiffness = symmetric_2x2(0, 1, 0);
   CHECK_THAT(why_invalid(s), Catch::Contains("stiffness is not positive semidefinite"));
   // Zero damping with its zeros stored is semidefinite.
   s = two_masses();
@@ -141,7 +141,7 @@ TEST_CASE("Validation names the field and the value", "[structure]") {
   REQUIRE(s.damping.nonZeros() == 4);
   CHECK(s.is_valid(nullptr));
   s.stiffness = to_sparse(Matrix::Zero(2, 2));
-  s.damping = to_sparse(swap);
+  s.damping = symmetric_2x2(0, 1, 0);
   CHECK_THAT(why_invalid(s), Catch::Contains("damping is not positive semidefinite"));
 }
 
