@@ -61,8 +61,8 @@ struct BandedExponentialOptions {
   bool share_rows = true;    // store identical rows once (BandedMatrix)
   // N and the Taylor order of every substructure. The doublings are trimmed to those the
   // substructure needs (precise_exponential.hpp), and a series of order 8 needs fewer of them:
-  // at η = 0.2 s a window of the paper's chain (‖Hη‖ = 0.8) runs 6 doublings of order 8 with
-  // its loads (ω up to 5 rad/s) and 4 for the switching PIM's force moments, where the paper's
+  // at η = 0.2 s a window of the paper's chain (‖Hη‖ = 0.96) runs 6 doublings of order 8 with
+  // its loads (ω up to 5 rad/s) and 5 for the switching PIM's force moments, where the paper's
   // N = 20 of order 4 ran 20, all exact to rounding. This was about a third of the switching
   // PIM's construction at n = 1000.
   PreciseExponentialOptions exponential{.taylor_order = 8, .trim_doublings = true};
