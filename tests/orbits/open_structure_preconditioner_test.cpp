@@ -1,0 +1,114 @@
+// The Newton-Krylov preconditioner J0⁻¹ = (M0 − I)⁻¹, M0 the monodromy of the open structure
+// (every gap spring open), against M0 from Eigen's matrix exponential of the 2n x 2n state
+// matrix: J0⁻¹ (M0 − I) v must give v back, on each of its three ways to the modes (a diagonal
+// mass with a tridiagonal or a wider stiffness, and a consistent, non-diagonal mass), and a
+// damping that is not classical must leave it unavailable.
+#include <catch2/catch.hpp>
+#include <random>
+#include <unsupported/Eigen/MatrixFunctions>
+
+#include "orbits/open_structure_preconditioner.hpp"
+#include "pwl/model/gap_structure.hpp"
+
+using namespace pwl;
+using pwl::orbits::detail::OpenStructurePreconditioner;
+
+namespace {
+
+// n masses in a line, grounded at both ends, with springs to the next mass (stiffness 1 + i/n)
+// and, when `second` > 0, to the one after it.
+Matrix line_stiffness(Index n, double second) {
+  Matrix K = Matrix::Zero(n, n);
+  const auto couple = [&](Index i, Index j, double k) {
+    K(i, i) += k;
+    K(j, j) += k;
+    K(i, j) -= k;
+    K(j, i) -= k;
+  };
+  for (Index i = 0; i + 1 < n; ++i) couple(i, i + 1, 1.0 + double(i) / double(n));
+  for (Index i = 0; second > 0 && i + 2 < n; ++i) couple(i, i + 2, second);
+  K(0, 0) += 2.0;
+  K(n - 1, n - 1) += 1.5;
+  return K;
+}
+
+GapStructure open_structure(const Matrix& M, const Matrix& K, const Matrix& C) {
+  GapStructure s;
+  s.mass = to_sparse(M);
+  s.stiffness = to_sparse(K);
+  s.damping = to_sparse(C);
+  return s;
+}
+
+// max over random v of |J0⁻¹ (M0 − I) v − v|_∞ / |v|_∞, M0 = exp(τ [[0, I], [−M⁻¹K, −M⁻¹C]]).
+double round_trip_error(const GapStructure& s, double tau) {
+  const Index n = s.dofs();
+  const Matrix M = Matrix(s.mass), K = Matrix(s.stiffness), C = Matrix(s.damping);
+  const Matrix inverse_mass = M.inverse();
+  Matrix A = Matrix::Zero(2 * n, 2 * n);
+  A.topRightCorner(n, n).setIdentity();
+  A.bottomLeftCorner(n, n) = -inverse_mass * K;
+  A.bottomRightCorner(n, n) = -inverse_mass * C;
+  const Matrix M0 = Matrix(A * tau).exp();
+  const OpenStructurePreconditioner p(s, tau);
+  REQUIRE(p.available());
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  double worst = 0.0;
+  for (int trial = 0; trial < 3; ++trial) {
+    Vector v(2 * n);
+    for (Index i = 0; i < 2 * n; ++i) v(i) = u(rng);
+    const Vector r = M0 * v - v;
+    worst = std::max(worst, (p.apply(r) - v).lpNorm<Eigen::Infinity>() / v.lpNorm<Eigen::Infinity>());
+  }
+  return worst;
+}
+
+}  // namespace
+
+TEST_CASE("The open structure's preconditioner inverts M0 − I on each of its paths to the modes",
+          "[orbits]") {
+  const Index n = 16;
+  Vector masses(n);
+  for (Index i = 0; i < n; ++i) masses(i) = 1.0 + 0.5 * std::sin(double(i));
+  const Matrix diagonal_mass = Matrix(masses.asDiagonal());
+  const double tau = 2.7;
+
+  SECTION("diagonal mass, tridiagonal stiffness (QR on the tridiagonal K̃ directly)") {
+    const Matrix K = line_stiffness(n, 0.0);
+    const Matrix C = 0.04 * diagonal_mass + 0.02 * K;  // Rayleigh: classical
+    CHECK(round_trip_error(open_structure(diagonal_mass, K, C), tau) <= 1e-11);
+  }
+  SECTION("diagonal mass, stiffness of bandwidth 2 (dense symmetric K̃)") {
+    const Matrix K = line_stiffness(n, 0.3);
+    const Matrix C = 0.04 * diagonal_mass + 0.02 * K;
+    CHECK(round_trip_error(open_structure(diagonal_mass, K, C), tau) <= 1e-11);
+  }
+  SECTION("consistent (tridiagonal) mass: the generalised problem") {
+    Matrix M = diagonal_mass;
+    for (Index i = 0; i + 1 < n; ++i) M(i, i + 1) = M(i + 1, i) = 0.1;
+    const Matrix K = line_stiffness(n, 0.0);
+    const Matrix C = 0.04 * M + 0.02 * K;
+    CHECK(round_trip_error(open_structure(M, K, C), tau) <= 1e-11);
+  }
+  SECTION("a dashpot at one end only is not classical damping: unavailable on every path") {
+    Matrix C = Matrix::Zero(n, n);
+    C(0, 0) = 0.3;
+    Matrix consistent = diagonal_mass;
+    for (Index i = 0; i + 1 < n; ++i) consistent(i, i + 1) = consistent(i + 1, i) = 0.1;
+    CHECK_FALSE(OpenStructurePreconditioner(
+                    open_structure(diagonal_mass, line_stiffness(n, 0.0), C), tau)
+                    .available());
+    CHECK_FALSE(OpenStructurePreconditioner(
+                    open_structure(diagonal_mass, line_stiffness(n, 0.3), C), tau)
+                    .available());
+    CHECK_FALSE(
+        OpenStructurePreconditioner(open_structure(consistent, line_stiffness(n, 0.0), C), tau)
+            .available());
+    // A damping only slightly off proportional (1e-6 of it at one mass) is still refused.
+    const Matrix K = line_stiffness(n, 0.0);
+    Matrix near = 0.04 * diagonal_mass + 0.02 * K;
+    near(3, 3) *= 1.0 + 1e-6;
+    CHECK_FALSE(OpenStructurePreconditioner(open_structure(diagonal_mass, K, near), tau).available());
+  }
+}
