@@ -7,6 +7,7 @@
 #include "pwl/model/chain_builders.hpp"
 #include "pwl/errors.hpp"
 #include "pwl/model/gap_structure.hpp"
+#include "test_structures.hpp"
 
 using namespace pwl;
 
@@ -152,14 +153,8 @@ TEST_CASE("Definiteness of wide and narrow bands", "[structure]") {
   for (bool ring : {false, true}) {
     const int n = 100;
     Matrix K = Matrix::Zero(n, n);
-    const auto couple = [&](int i, int j, double k) {
-      K(i, i) += k;
-      K(j, j) += k;
-      K(i, j) -= k;
-      K(j, i) -= k;
-    };
-    for (int i = 0; i + 1 < n; ++i) couple(i, i + 1, 1.0);
-    if (ring) couple(n - 1, 0, 1.0);
+    for (int i = 0; i + 1 < n; ++i) pwl::test::add_spring(K, i, i + 1, 1.0);
+    if (ring) pwl::test::add_spring(K, n - 1, 0, 1.0);
     GapStructure s;
     s.mass = to_sparse(Matrix::Identity(n, n));
     s.damping = to_sparse(Matrix::Zero(n, n));

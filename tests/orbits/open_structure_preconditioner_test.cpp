@@ -7,8 +7,10 @@
 #include <random>
 #include <unsupported/Eigen/MatrixFunctions>
 
+#include "orbit_cases.hpp"
 #include "orbits/open_structure_preconditioner.hpp"
 #include "pwl/model/gap_structure.hpp"
+#include "test_structures.hpp"
 
 using namespace pwl;
 using pwl::orbits::detail::OpenStructurePreconditioner;
@@ -19,14 +21,8 @@ namespace {
 // and, when `second` > 0, to the one after it.
 Matrix line_stiffness(Index n, double second) {
   Matrix K = Matrix::Zero(n, n);
-  const auto couple = [&](Index i, Index j, double k) {
-    K(i, i) += k;
-    K(j, j) += k;
-    K(i, j) -= k;
-    K(j, i) -= k;
-  };
-  for (Index i = 0; i + 1 < n; ++i) couple(i, i + 1, 1.0 + double(i) / double(n));
-  for (Index i = 0; second > 0 && i + 2 < n; ++i) couple(i, i + 2, second);
+  for (Index i = 0; i + 1 < n; ++i) test::add_spring(K, i, i + 1, 1.0 + double(i) / double(n));
+  for (Index i = 0; second > 0 && i + 2 < n; ++i) test::add_spring(K, i, i + 2, second);
   K(0, 0) += 2.0;
   K(n - 1, n - 1) += 1.5;
   return K;
@@ -40,16 +36,11 @@ GapStructure open_structure(const Matrix& M, const Matrix& K, const Matrix& C) {
   return s;
 }
 
-// max over random v of |J0⁻¹ (M0 − I) v − v|_∞ / |v|_∞, M0 = exp(τ [[0, I], [−M⁻¹K, −M⁻¹C]]).
+// max over random v of |J0⁻¹ (M0 − I) v − v|_∞ / |v|_∞, M0 = exp(τ H), H the state matrix with
+// every spring open.
 double round_trip_error(const GapStructure& s, double tau) {
   const Index n = s.dofs();
-  const Matrix M = Matrix(s.mass), K = Matrix(s.stiffness), C = Matrix(s.damping);
-  const Matrix inverse_mass = M.inverse();
-  Matrix A = Matrix::Zero(2 * n, 2 * n);
-  A.topRightCorner(n, n).setIdentity();
-  A.bottomLeftCorner(n, n) = -inverse_mass * K;
-  A.bottomRightCorner(n, n) = -inverse_mass * C;
-  const Matrix M0 = Matrix(A * tau).exp();
+  const Matrix M0 = Matrix(test::state_matrix(s) * tau).exp();
   const OpenStructurePreconditioner p(s, tau);
   REQUIRE(p.available());
   std::mt19937 rng(3);

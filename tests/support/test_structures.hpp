@@ -21,6 +21,14 @@ inline GapStructure single_mass(double m, double c, double k) {
   return s;
 }
 
+// A spring of stiffness k between degrees of freedom i and j, added to the stiffness matrix K.
+inline void add_spring(Matrix& K, Index i, Index j, double k) {
+  K(i, i) += k;
+  K(j, j) += k;
+  K(i, j) -= k;
+  K(j, i) -= k;
+}
+
 // The paper's section 4.2 chain with every cell drawn at random (seeded): masses and springs k1 in
 // [0.5, 2], dampers in damping_scale · [0.5, 2], and, when vary_gap_springs, the gap springs k2
 // in [0.5, 2] too. Cells that differ make a structure without a period, so that nothing can be

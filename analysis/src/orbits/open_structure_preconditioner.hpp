@@ -34,6 +34,7 @@
 #include <complex>
 #include <vector>
 
+#include "pwl/integrators/banded_pim_integrator.hpp"
 #include "pwl/model/gap_structure.hpp"
 
 namespace pwl::orbits::detail {
@@ -44,7 +45,7 @@ class OpenStructurePreconditioner {
   OpenStructurePreconditioner(const GapStructure& structure, double tau) {
     const Index n = structure.dofs();
     Vector omega2, modal_damping;
-    if (!diagonal(structure.mass)) {
+    if (!banded_layout(structure).diagonal_mass) {
       // The generalised problem, dense, and Φ^T C Φ formed whole.
       const Matrix M = Matrix(structure.mass);
       Eigen::GeneralizedSelfAdjointEigenSolver<Matrix> modes(Matrix(structure.stiffness), M);
@@ -137,15 +138,6 @@ class OpenStructurePreconditioner {
     const double sh_over_s = std::abs(s) < 1e-8 ? 1.0 + (s * s).real() / 6.0
                                                 : (std::sinh(s) / s).real();
     return std::exp(half_trace) * (ch * Eigen::Matrix2d::Identity() + sh_over_s * B);
-  }
-
-  static bool diagonal(const SparseMatrix& A) {
-    for (Index c = 0; c < A.outerSize(); ++c) {
-      for (SparseMatrix::InnerIterator it(A, c); it; ++it) {
-        if (it.row() != it.col() && it.value() != 0.0) return false;
-      }
-    }
-    return true;
   }
 
   // The largest |i − j| of a stored non-zero.
