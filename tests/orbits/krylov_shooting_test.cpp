@@ -143,6 +143,56 @@ TEST_CASE("Newton-Krylov on the banded switching PIM replays its tangent product
   CHECK(krylov_map.evaluations() < krylov.krylov_products);
 }
 
+TEST_CASE("the stroboscopic map replays a plain evaluation's tangent, not a long transient's",
+          "[orbits]") {
+  // The banded switching PIM's map records plain integrations too: a product from the state just
+  // evaluated, over the same span, is a replay, bit for bit the product a fresh map integrates.
+  // A plain run of more than 64 periods is not recorded: its product integrates again.
+  NondimensionalChain chain;
+  chain.masses = 40;
+  chain.alpha = {2.0};
+  chain.gap = {0.0};
+  chain.amplitude = {1.0};
+  chain.theta = 1.5;
+  const auto make = [&] {
+    return StroboscopicMap(analysis::PointCase(chain), MethodSettings{Method::pim_switching_banded},
+                           100);
+  };
+  StroboscopicMap map = make(), fresh = make();
+  const Vector y = pwl::test::harmonic_response(map.structure(), chain.theta);
+  Matrix V(map.state_size(), 2);
+  for (Index i = 0; i < V.rows(); ++i) {
+    V(i, 0) = std::sin(0.3 + 0.9 * static_cast<double>(i));
+    V(i, 1) = std::cos(1.1 + 0.4 * static_cast<double>(i));
+  }
+  for (const int periods : {1, 2}) {
+    INFO(periods << " period(s)");
+    const Vector end = map.advance(y, periods);
+    const long evaluations = map.evaluations(), replays = map.tangent_replays();
+    Matrix replayed = V, integrated = V;
+    const Vector end_replayed = map.advance(y, periods, replayed);
+    const Vector end_integrated = fresh.advance(y, periods, integrated);
+    CHECK(map.tangent_replays() == replays + 1);
+    CHECK(map.evaluations() == evaluations);
+    CHECK((end_replayed - end_integrated).cwiseAbs().maxCoeff() == 0.0);
+    CHECK((end - end_integrated).cwiseAbs().maxCoeff() == 0.0);
+    CHECK((replayed - integrated).cwiseAbs().maxCoeff() == 0.0);
+    CHECK(integrated.cwiseAbs().maxCoeff() > 0.1);
+  }
+  // A long transient: not recorded, its product is an integration.
+  map.advance(y, 65);
+  const long evaluations = map.evaluations(), replays = map.tangent_replays();
+  Matrix long_product = V;
+  map.advance(y, 65, long_product);
+  CHECK(map.tangent_replays() == replays);
+  CHECK(map.evaluations() == evaluations + 1);
+  // And from there on the map records again.
+  map.advance(y, 1);
+  Matrix again = V;
+  map.advance(y, 1, again);
+  CHECK(map.tangent_replays() == replays + 1);
+}
+
 TEST_CASE("thick-restarted Arnoldi resolves long-wave multipliers crowded against 1",
           "[orbits]") {
   // A = S D S⁻¹ of size 1000 with the spectrum of a long chain's orbit: the long-wave modes crowd

@@ -19,7 +19,8 @@ StroboscopicMap::StroboscopicMap(const analysis::PointCase& point, const MethodS
   }
   settings_ = settings.for_period(point.period, steps_per_period);
   integrator_ = make_integrator(point_.structure, settings_);
-  if (integrator_->can_record_tangent()) integrator_->record_tangent(true);
+  recording_ = integrator_->can_record_tangent();
+  if (recording_) integrator_->record_tangent(true);
 }
 
 StroboscopicMap::~StroboscopicMap() = default;
@@ -42,6 +43,15 @@ Vector StroboscopicMap::integrate(const Vector& y, double t0, double t1, Matrix*
     return base_end_;
   }
   replay_ready_ = false;
+  // Plain integrations are recorded too, over the spans whose products a shooting method takes
+  // (up to kReplayPeriods forcing periods); a long transient's record would only fill memory up
+  // to the integrator's bound and be dropped.
+  const bool record = integrator_->can_record_tangent() &&
+                      (tangent != nullptr || t1 - t0 <= kReplayPeriods * forcing_period() * (1 + 1e-12));
+  if (record != recording_) {
+    integrator_->record_tangent(record);
+    recording_ = record;
+  }
   integrator_->set_state(t0, y.head(n), y.tail(n));
   if (tangent != nullptr) {
     integrator_->advance_with_tangent(t1, *tangent);
@@ -51,7 +61,10 @@ Vector StroboscopicMap::integrate(const Vector& y, double t0, double t1, Matrix*
   ++evaluations_;
   Vector out(2 * n);
   out << integrator_->position(), integrator_->velocity();
-  if (tangent != nullptr && integrator_->can_record_tangent()) {
+  // The integrator recorded what fixes the tangent map, with or without the tangent: a product
+  // from the same state over the same span (the first GMRES product after Newton's line search
+  // accepted this state, say) is a replay.
+  if (recording_) {
     base_start_ = y;
     base_end_ = out;
     base_t0_ = t0;

@@ -347,13 +347,14 @@ class BandedStepper final : public SwitchingPim,
   // One step and its tangent map. A switching step maps the tangent piece by piece as it goes
   // (ModeSeries::tangent_piece); a smooth step is affine in the start state for the mode it
   // starts in and the LCP's active set, and tangent_smooth_step() applies its linear part after it.
+  // Without a tangent (a plain advance while recording) the step only notes what fixes it.
   void step_with_tangent() {
-    replay_step_start();
+    if (tangent_ != nullptr) replay_step_start();
     this->note({TangentOp::Kind::step_start});
     const long before = diagnostics_.switching_steps;
     step();
     if (diagnostics_.switching_steps == before) {
-      tangent_smooth_step();
+      if (tangent_ != nullptr) tangent_smooth_step();
       this->note({TangentOp::Kind::smooth_step});
     }
   }
@@ -377,10 +378,17 @@ class BandedStepper final : public SwitchingPim,
   // LCP replaced by the linear solve on its active set A (the derivative of the LCP's solution
   // where A is locally constant: dz_A = -M_AA⁻¹ dq_A, dz = 0 elsewhere): one banded product
   // with T, d + 1 sparse recursion terms and the forces of the touching springs, as the step.
+  //
+  // The recursion only feeds the forces p_r of the springs touching at the start. Each term
+  // couples rows at most reach_ apart, so when few springs touch, the terms are computed on the
+  // rows their p_r reach back to (force_window_), with the sparse rows as the local switch
+  // corrections use them: O(touching springs · d² reach) per column instead of O(n d). None
+  // touching: no recursion at all.
   void tangent_smooth_step() {
     Matrix& Y = *tangent_;
     const int last = d_ + (end_derivative_ ? 1 : 0);  // the last p_r the step uses
     if (m_ > 0 && !acting_.empty()) factor_active_set(acting_);
+    const bool windowed = !start_acting_.empty() && prepare_force_window(last);
     for (Index c = 0; c < Y.cols(); ++c) {
       t_x_ = Y.col(c).head(n_);
       t_u_ = Y.col(c).tail(n_);
@@ -392,7 +400,8 @@ class BandedStepper final : public SwitchingPim,
       }
       transition_.multiply(t_y_.data(), t_bar_.data());
       if (end_derivative_) t_slope_.setZero(m_);
-      for (int r = 0; r <= last && m_ > 0; ++r) {
+      if (windowed) windowed_force_recursion(last);
+      for (int r = 0; r <= last && !start_acting_.empty() && !windowed; ++r) {
         band_product(gap_band_, t_x_, t_g_);
         t_p_ = start_mode_.cwiseProduct(stiffnesses_.cwiseProduct(t_g_));
         const auto ru = static_cast<std::size_t>(r);
@@ -425,6 +434,67 @@ class BandedStepper final : public SwitchingPim,
         Y(n_ + i, c) = t_bar_[2 * i + 1];
       }
     }
+  }
+
+  // The rows of the windowed recursion of tangent_smooth_step for the springs touching at the
+  // start, their masses R: force_window_[r] holds the rows of the r-th terms. p_r needs x_r on R;
+  // x_r = f u_{r-1} needs u_{r-1} on R, and u_{r-1} = f a_{r-2} needs the terms r - 2 on R
+  // widened by reach_. So the terms r < last live on R widened by reach_ (last - 1 - r) and the
+  // last on R. False (use the whole state) when the window covers half the rows or more.
+  bool prepare_force_window(int last) {
+    switching_detail::RowRanges masses;
+    for (int j : start_acting_) {
+      for (RowSparse::InnerIterator it(gap_rows_, j); it; ++it) masses.add(it.col(), it.col() + 1);
+    }
+    masses.normalize();
+    force_window_.resize(static_cast<std::size_t>(last) + 1);
+    for (int r = 1; r <= last; ++r) {
+      force_window_[static_cast<std::size_t>(r)].widen_from(
+          masses, reach_ * std::max(0, last - 1 - r), n_);
+    }
+    if (last >= 1 && 2 * force_window_[1].rows() >= n_) return false;
+    for (Vector* v : {&w_x_[0], &w_x_[1], &w_u_[0], &w_u_[1]}) {
+      if (v->size() != n_) v->setZero(n_);
+    }
+    t_p_.setZero(m_);
+    return true;
+  }
+
+  // The force recursion of tangent_smooth_step on force_window_, from t_x_, t_u_ (the column's
+  // start), into t_bar_ and t_slope_; p_r is t_p_ on the touching springs (zero elsewhere, as
+  // start_mode_ makes it in the whole-state form).
+  void windowed_force_recursion(int last) {
+    const Vector* x = &t_x_;
+    const Vector* u = &t_u_;
+    for (int r = 0; r <= last; ++r) {
+      for (int j : start_acting_) {
+        double g = 0.0;
+        for (RowSparse::InnerIterator it(gap_rows_, j); it; ++it) g += it.value() * (*x)[it.col()];
+        t_p_[j] = stiffnesses_[j] * g;
+      }
+      const auto ru = static_cast<std::size_t>(r);
+      add_forces(correction_[ru], correction_columns_[ru], t_p_, t_bar_, start_acting_);
+      if (end_derivative_ && r >= 1) {
+        for (int j : start_acting_) t_slope_[j] += static_cast<double>(r) * t_p_[j];
+      }
+      if (r == last) break;
+      const double f = eta_ / (r + 1);
+      Vector& x1 = w_x_[ru & 1];
+      Vector& u1 = w_u_[ru & 1];
+      const bool accelerate_u = r < d_;
+      force_window_[ru + 1].for_each_row([&](Index i) {
+        x1[i] = f * (*u)[i];
+        if (!accelerate_u) return;
+        double acc = 0.0;
+        for (RowSparse::InnerIterator it(stiffness_part_, i); it; ++it) acc += it.value() * (*x)[it.col()];
+        for (RowSparse::InnerIterator it(damping_part_, i); it; ++it) acc += it.value() * (*u)[it.col()];
+        for (RowSparse::InnerIterator it(force_part_, i); it; ++it) acc += it.value() * t_p_[it.col()];
+        u1[i] = f * acc;
+      });
+      x = &x1;
+      u = &u1;
+    }
+    for (int j : start_acting_) t_p_[j] = 0.0;
   }
 
   // The band LU (no pivoting: M is a P-matrix, so every leading principal minor of M_AA is
@@ -673,6 +743,8 @@ class BandedStepper final : public SwitchingPim,
   std::vector<double> lu_, t_rhs_;
   Vector t_x_, t_u_, t_y_, t_bar_, t_acc_, t_g_, t_p_, t_slope_, t_z_;
   Vector t_half_ = Vector::Zero(n_);
+  std::vector<switching_detail::RowRanges> force_window_;
+  Vector w_x_[2], w_u_[2];  // the windowed recursion's terms, alternately
 };
 
 }  // namespace

@@ -202,7 +202,8 @@ class LocalSwitchCorrection {
       scale_ = std::max({scale_, st.xs_[static_cast<std::size_t>(r)].cwiseAbs().maxCoeff(),
                          st.us_[static_cast<std::size_t>(r)].cwiseAbs().maxCoeff()});
     }
-    const bool keep = st.tangent_ != nullptr;
+    // The step's record, for its tangent now (advance_with_tangent) or for a replay later.
+    const bool keep = st.tangent_ != nullptr || st.noting();
     LocalStep record;
     if (keep) {
       record.base_mode = base_mode_;
@@ -397,7 +398,7 @@ class LocalSwitchCorrection {
     st.diagnostics_.pieces += 1 + local_pieces_;
     st.diagnostics_.local_rows += local_rows_;
     if (keep) {
-      local_tangent(record, *st.tangent_);
+      if (st.tangent_ != nullptr) local_tangent(record, *st.tangent_);
       if (st.noting()) {
         // Kept within the same bound as the record's entries (ModeSeries::kRecordLimit of them):
         // beyond it the record is dropped (no replay) rather than grow without bound.

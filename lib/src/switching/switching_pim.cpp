@@ -457,7 +457,7 @@ class Stepper final
     start_mode_ = mode_;
     const long before = diagnostics_.switching_steps;
     step();
-    if (diagnostics_.switching_steps == before) tangent_smooth_step(op);
+    if (diagnostics_.switching_steps == before && this->tangent_ != nullptr) tangent_smooth_step(op);
   }
 
   // The linear part of a smooth step applied to the tangent columns: the step's formula with the

@@ -229,14 +229,15 @@ class ModeSeries {
 
   // The grid driver of both steppers' advance_to and advance_with_tangent: every step to t_end,
   // and with `tangent` (2n x p, rows [x; x']) the tangent map of each step applied to it
-  // (step_with_tangent; tangent_ points to it for the duration).
+  // (step_with_tangent; tangent_ points to it for the duration). While a record is open, steps
+  // without the tangent note what fixes it all the same (step_with_tangent with tangent_ null),
+  // so that a plain integration can be replayed as well.
   void advance_steps(double t_end, Matrix* tangent, const StepObserver& observer) {
     Stepper& st = self();
     if (tangent != nullptr && tangent->rows() != 2 * st.n_) {
       throw InputError(fmt::format("tangent has {} rows; the state [x; x'] has {}",
                                    tangent->rows(), 2 * st.n_));
     }
-    if (tangent == nullptr) end_record();  // a stretch without the tangent: no replay
     tangent_ = tangent;
     struct Release {
       Matrix*& tangent;
@@ -247,8 +248,8 @@ class ModeSeries {
     try {
       detail::advance_on_grid(
           t_end, st.time(), st.eta_, observer, st.position_, st.velocity_,
-          [&st, tangent] {
-            if (tangent != nullptr) {
+          [this, &st, tangent] {
+            if (tangent != nullptr || noting()) {
               st.step_with_tangent();
             } else {
               st.step();
@@ -266,10 +267,11 @@ class ModeSeries {
   // Tangent recording (Integrator::record_tangent, replay_tangent). The record lists what fixes
   // the tangent map of the motion since set_state, in order: the springs' mode changes, the start
   // of each step, each smooth step's linear part and each piece of a switching step (its step h,
-  // its series terms R and where it ends, σ). Replaying it from the mode at set_state repeats
-  // exactly the tangent arithmetic of advance_with_tangent, without the state's series, the
-  // search for switches or the LCP. A few entries per step and switch; beyond kRecordLimit
-  // entries the record is dropped (no replay) rather than grow without bound.
+  // its series terms R and where it ends, σ). The state's path does not depend on the tangent,
+  // so advance_to notes the same entries as advance_with_tangent. Replaying it from the mode at
+  // set_state repeats exactly the tangent arithmetic of advance_with_tangent, without the state's
+  // series, the search for switches or the LCP. A few entries per step and switch; beyond
+  // kRecordLimit entries the record is dropped (no replay) rather than grow without bound.
   struct TangentOp {
     // local_step: a switching step corrected locally (local_switch_correction.hpp), whose
     // record the stepper keeps; `spring` is its index there.
@@ -302,9 +304,9 @@ class ModeSeries {
     self().clear_local_records();
   }
 
-  // Appends to an open record while advance_with_tangent runs (not while replaying).
+  // Appends to an open record while the stepper advances (not while replaying).
   void note(const TangentOp& op) {
-    if (!record_open_ || replaying_ || tangent_ == nullptr) return;
+    if (!record_open_ || replaying_) return;
     if (record_.size() >= kRecordLimit) {
       end_record();
       record_.shrink_to_fit();
@@ -312,10 +314,8 @@ class ModeSeries {
     }
     record_.push_back(op);
   }
-  // True while advance_with_tangent records (note() keeps what it is given).
-  bool noting() const {
-    return record_open_ && !replaying_ && tangent_ != nullptr && record_.size() < kRecordLimit;
-  }
+  // True while the stepper records (note() keeps what it is given).
+  bool noting() const { return record_open_ && !replaying_ && record_.size() < kRecordLimit; }
   void note_mode(Index j, bool on) {
     TangentOp op;
     op.kind = on ? TangentOp::Kind::mode_on : TangentOp::Kind::mode_off;
@@ -578,8 +578,8 @@ class ModeSeries {
       }
       const double sigma = r.found ? r.at.t : 1.0;
       evaluate_series(R, sigma);
-      if (tangent_ != nullptr) {
-        tangent_piece(h, R, sigma);
+      if (tangent_ != nullptr) tangent_piece(h, R, sigma);
+      if (noting()) {
         TangentOp op;
         op.kind = TangentOp::Kind::piece;
         op.terms = R;

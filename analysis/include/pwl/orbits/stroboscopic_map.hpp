@@ -23,10 +23,12 @@
 // Repeated products. Krylov methods (the GMRES of Newton-Krylov shooting, Arnoldi for the
 // multipliers) multiply many vectors by one Jacobian, each product a tangent integration from the
 // same state. When the integrator can record its tangent map (Integrator::can_record_tangent: the
-// banded switching PIM) the map records it on the first product and replays it for the next ones
-// from the same state over the same span, without integrating the state again; the products are
-// the same to the last bit. A plain evaluation, another state or span, or a caller that takes the
-// integrator ends the record.
+// banded switching PIM) the map records it on every evaluation, with or without products, and
+// replays it for the products that follow from the same state over the same span, without
+// integrating the state again; the products are the same to the last bit. So the first GMRES
+// product after Newton's line search has accepted a state is a replay of the line search's own
+// integration (plain integrations are recorded over at most 64 forcing periods). Another state or
+// span, or a caller that takes the integrator, ends the record.
 #include <memory>
 
 #include "pwl/integrators/integrator.hpp"
@@ -92,7 +94,10 @@ class StroboscopicMap {
   std::unique_ptr<Integrator> integrator_;
   long evaluations_ = 0;
   long replays_ = 0;
-  // The last tangent integration, whose record the integrator holds: its start, span and end.
+  // Plain integrations longer than this many forcing periods are not recorded.
+  static constexpr int kReplayPeriods = 64;
+  bool recording_ = false;  // the integrator's record_tangent
+  // The last recorded integration, whose record the integrator holds: its start, span and end.
   bool replay_ready_ = false;
   Vector base_start_, base_end_;
   double base_t0_ = 0.0, base_t1_ = 0.0;

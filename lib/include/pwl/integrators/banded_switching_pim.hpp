@@ -43,17 +43,19 @@
 // Tangent map (advance_with_tangent): the dense stepper's (switching_pim.hpp), the derivative of
 // the numerical step map applied to p columns (2n x p, rows [x; x'], not interleaved), column by
 // column with the step's own banded and sparse products: a smooth step costs one product with T,
-// d + 1 sparse recursion terms and the touching springs' forces per column, the LCP's active-set
-// solve a band LU of M_AA (refactorised only from the first index where the active set changed),
-// and a piece of a switching step its Taylor terms; O(n q) per column and step, nothing 2n x 2n.
+// d + 1 recursion terms and the touching springs' forces per column (the terms only on the rows
+// within at most d reaches of the springs touching at the step's start, none when none touch, the
+// whole state when those rows are half the chain or more), the LCP's active-set solve a band LU
+// of M_AA (refactorised only from the first index where the active set changed), and a piece of
+// a switching step its Taylor terms; O(n q) per column and step, nothing 2n x 2n.
 //
-// Tangent replay (Integrator::record_tangent, replay_tangent): while recording, the stepper notes
-// what fixes its tangent map (each step's start, its smooth steps, the pieces of its switching
-// steps with their lengths and series terms, the springs' mode changes) and applies that record
-// again to other columns without the state's series, the search for switches or the LCP. The
-// columns come out as advance_with_tangent gives them, to the last bit. On the 1000-mass chain of
-// `pwl bench orbits`, whose springs switch about 2000 times a period, a replayed product costs
-// about a third of an integration with its tangent.
+// Tangent replay (Integrator::record_tangent, replay_tangent): while recording, the stepper notes,
+// in advance_to as in advance_with_tangent, what fixes its tangent map (each step's start, its
+// smooth steps, the pieces of its switching steps with their lengths and series terms, the
+// springs' mode changes) and applies that record again to other columns without the state's
+// series, the search for switches or the LCP. The columns come out as advance_with_tangent gives
+// them, to the last bit. On the 1000-mass chain of `pwl bench orbits`, whose springs switch about
+// 2000 times a period, a replayed product costs about a third of an integration with its tangent.
 //
 // References: W. X. Zhong and F. W. Williams, Proc. IMechE C 208 (1994) 427-430 (precise
 // integration); He Dongdong, Gao Qiang and Zhong Wanxie, Appl. Math. Mech. 39(7) (2018) 737-749

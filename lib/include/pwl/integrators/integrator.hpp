@@ -65,15 +65,16 @@ class Integrator {
   // replayed columns equal what advance_with_tangent gives them, to the last bit.
   //
   // Recording is off by default: the record grows with the run. While it is on, set_state starts
-  // a new record, each advance_with_tangent extends it, and advance_to (or a run that throws)
-  // ends it. Integrators without it answer false and ignore record_tangent(false).
+  // a new record, each advance_with_tangent or advance_to extends it (the motion fixes the
+  // tangent map whether or not tangent columns ride along), and a run that throws ends it.
+  // Integrators without it answer false and ignore record_tangent(false).
   virtual bool can_record_tangent() const { return false; }
   // Throws InputError when asked to record without can_record_tangent().
   virtual void record_tangent(bool on);
   // Applies the tangent map of the motion from the last set_state to time(), as recorded, to
   // `tangent` (2n x p); leaves the state alone. False (and `tangent` untouched) when there is no
-  // complete record: recording off, an advance_to since set_state, or a record that outgrew its
-  // limit.
+  // complete record: recording off, a run that threw since set_state, or a record that outgrew
+  // its limit.
   virtual bool replay_tangent(Matrix& tangent);
 };
 
