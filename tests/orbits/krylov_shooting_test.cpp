@@ -42,16 +42,28 @@ Matrix similar_to(const Matrix& D, std::mt19937& rng) {
   return S * D * S.inverse();
 }
 
-}  // namespace
-
-TEST_CASE("Newton-Krylov and dense Newton find the same periodic orbit of a 50-mass chain",
-          "[orbits]") {
+// The figure 4a chain (α = 2, Δ̃ = 0, Q = 1 on every mass) at θ = 1.5: springs that open and
+// close every period.
+NondimensionalChain contact_chain(int masses) {
   NondimensionalChain chain;
-  chain.masses = 50;
+  chain.masses = masses;
   chain.alpha = {2.0};
   chain.gap = {0.0};
   chain.amplitude = {1.0};
   chain.theta = 1.5;
+  return chain;
+}
+
+StroboscopicMap banded_switching_map(const NondimensionalChain& chain) {
+  return StroboscopicMap(analysis::PointCase(chain), MethodSettings{Method::pim_switching_banded},
+                         100);
+}
+
+}  // namespace
+
+TEST_CASE("Newton-Krylov and dense Newton find the same periodic orbit of a 50-mass chain",
+          "[orbits]") {
+  const NondimensionalChain chain = contact_chain(50);
   // A 100x100 problem gains nothing from Eigen's threads, and on a loaded machine their spinning
   // costs seconds.
   Eigen::setNbThreads(1);
@@ -105,18 +117,9 @@ TEST_CASE("Newton-Krylov on the banded switching PIM replays its tangent product
   // on a Krylov method's first product and replays for the next ones from the same state: dense
   // Newton (whole monodromies, never replayed) and Newton-Krylov must land on the same orbit, with
   // the same leading multipliers, and the replays must have replaced most integrations.
-  NondimensionalChain chain;
-  chain.masses = 50;
-  chain.alpha = {2.0};
-  chain.gap = {0.0};
-  chain.amplitude = {1.0};
-  chain.theta = 1.5;
+  const NondimensionalChain chain = contact_chain(50);
   Eigen::setNbThreads(1);
-  const auto make = [&] {
-    return StroboscopicMap(analysis::PointCase(chain), MethodSettings{Method::pim_switching_banded},
-                           100);
-  };
-  StroboscopicMap dense_map = make(), krylov_map = make();
+  StroboscopicMap dense_map = banded_switching_map(chain), krylov_map = banded_switching_map(chain);
   REQUIRE(krylov_map.exact_tangent());
   REQUIRE(krylov_map.integrator().can_record_tangent());
   const Vector seed = pwl::test::harmonic_response(krylov_map.structure(), chain.theta);
@@ -148,17 +151,8 @@ TEST_CASE("the stroboscopic map replays a plain evaluation's tangent, not a long
   // The banded switching PIM's map records plain integrations too: a product from the state just
   // evaluated, over the same span, is a replay, bit for bit the product a fresh map integrates.
   // A plain run of more than 64 periods is not recorded: its product integrates again.
-  NondimensionalChain chain;
-  chain.masses = 40;
-  chain.alpha = {2.0};
-  chain.gap = {0.0};
-  chain.amplitude = {1.0};
-  chain.theta = 1.5;
-  const auto make = [&] {
-    return StroboscopicMap(analysis::PointCase(chain), MethodSettings{Method::pim_switching_banded},
-                           100);
-  };
-  StroboscopicMap map = make(), fresh = make();
+  const NondimensionalChain chain = contact_chain(40);
+  StroboscopicMap map = banded_switching_map(chain), fresh = banded_switching_map(chain);
   const Vector y = pwl::test::harmonic_response(map.structure(), chain.theta);
   Matrix V(map.state_size(), 2);
   for (Index i = 0; i < V.rows(); ++i) {
