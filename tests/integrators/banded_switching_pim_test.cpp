@@ -265,9 +265,10 @@ Matrix cosine_columns(Index rows, Index cols, double a, double b, double c) {
   return V;
 }
 
-// The dense and the banded stepper's tangent maps of the motion from y0 over [t0, t1] applied to
-// V, with the two steppers' diagnostics.
+// The dense and the banded stepper's tangent maps of the motion from y0 = moving_state(t0) over
+// [t0, t1] applied to V, with the two steppers' diagnostics.
 struct TangentPair {
+  Vector y0;
   Matrix dense, banded;
   SwitchingPimDiagnostics dense_run, banded_run;
   // max |Jb - Jd| relative to max |Jd|
@@ -276,15 +277,16 @@ struct TangentPair {
   }
 };
 TangentPair dense_and_banded_tangents(const GapStructure& s, double eta, double t0, double t1,
-                                      const Vector& y0, const Matrix& V) {
+                                      const Matrix& V) {
   const Index n = s.dofs();
+  const Vector y0 = moving_state(s, eta, t0);
   SwitchingPimOptions dense_options;
   dense_options.step = eta;
   auto dense = make_switching_pim(s, dense_options);
   auto banded = make_banded_switching_pim(s, banded_options(eta));
   dense->set_state(t0, y0.head(n), y0.tail(n));
   banded->set_state(t0, y0.head(n), y0.tail(n));
-  TangentPair out{V, V, {}, {}};
+  TangentPair out{y0, V, V, {}, {}};
   dense->advance_with_tangent(t1, out.dense);
   banded->advance_with_tangent(t1, out.banded);
   out.dense_run = dense->diagnostics();
@@ -336,10 +338,8 @@ TEST_CASE("banded switching PIM: the tangent map is the dense one's", "[banded][
   // and their tangents agree up to the band's truncation and rounding.
   const GapStructure s = switching_chain(96);
   const double eta = 0.02, t0 = 4.0, t1 = 10.0;
-  const Index n = s.dofs();
-  const Vector y0 = moving_state(s, eta, t0);
-  const Matrix V = cosine_columns(2 * n, 4, 0.3, 1.7, 2.9);
-  const TangentPair J = dense_and_banded_tangents(s, eta, t0, t1, y0, V);
+  const TangentPair J = dense_and_banded_tangents(s, eta, t0, t1,
+                                                  cosine_columns(2 * s.dofs(), 4, 0.3, 1.7, 2.9));
   const SwitchingPimDiagnostics& a = J.dense_run;
   const SwitchingPimDiagnostics& b = J.banded_run;
   const double difference = J.difference();
@@ -366,9 +366,9 @@ TEST_CASE("banded switching PIM: the tangent map where a few springs touch in a 
   const GapStructure s = make_chain(p);
   const double eta = 0.02, t0 = 6.0, t1 = 14.0;
   const Index n = s.dofs();
-  const Vector y0 = moving_state(s, eta, t0);
   const Matrix V = cosine_columns(2 * n, 3, 0.5, 1.1, 2.3);
-  const TangentPair J = dense_and_banded_tangents(s, eta, t0, t1, y0, V);
+  const TangentPair J = dense_and_banded_tangents(s, eta, t0, t1, V);
+  const Vector& y0 = J.y0;
   const Matrix& Jb = J.banded;
   const SwitchingPimDiagnostics& b = J.banded_run;
   const double difference = J.difference();

@@ -467,11 +467,7 @@ class BandedStepper final : public SwitchingPim,
     const Vector* x = &t_x_;
     const Vector* u = &t_u_;
     for (int r = 0; r <= last; ++r) {
-      for (int j : start_acting_) {
-        double g = 0.0;
-        for (RowSparse::InnerIterator it(gap_rows_, j); it; ++it) g += it.value() * (*x)[it.col()];
-        t_p_[j] = stiffnesses_[j] * g;
-      }
+      for (int j : start_acting_) t_p_[j] = stiffnesses_[j] * spring_stretch(j, *x);
       const auto ru = static_cast<std::size_t>(r);
       add_forces(correction_[ru], correction_columns_[ru], t_p_, t_bar_, start_acting_);
       if (end_derivative_ && r >= 1) {
@@ -484,12 +480,7 @@ class BandedStepper final : public SwitchingPim,
       const bool accelerate_u = r < d_;
       force_window_[ru + 1].for_each_row([&](Index i) {
         x1[i] = f * (*u)[i];
-        if (!accelerate_u) return;
-        double acc = 0.0;
-        for (RowSparse::InnerIterator it(stiffness_part_, i); it; ++it) acc += it.value() * (*x)[it.col()];
-        for (RowSparse::InnerIterator it(damping_part_, i); it; ++it) acc += it.value() * (*u)[it.col()];
-        for (RowSparse::InnerIterator it(force_part_, i); it; ++it) acc += it.value() * t_p_[it.col()];
-        u1[i] = f * acc;
+        if (accelerate_u) u1[i] = f * row_acceleration(i, *x, *u, [&](Index j) { return t_p_[j]; });
       });
       x = &x1;
       u = &u1;
@@ -571,6 +562,22 @@ class BandedStepper final : public SwitchingPim,
     band_product(stiffness_band_, x, acc);
     damping_band_.multiply_add(u.data(), acc.data());
     if (forces) force_band_.multiply_add(p.data(), acc.data());
+  }
+  // (W^T x)_j: spring j's stretch in the displacement x, from its sparse row.
+  double spring_stretch(Index j, const Vector& x) const {
+    double g = 0.0;
+    for (RowSparse::InnerIterator it(gap_rows_, j); it; ++it) g += it.value() * x[it.col()];
+    return g;
+  }
+  // Row i of -M⁻¹ (K x + C u + W p) from the sparse rows, p_j = force_of(j): the windowed series
+  // (the local switch corrections', the smooth steps' tangent recursion) row by row.
+  template <class ForceOf>
+  double row_acceleration(Index i, const Vector& x, const Vector& u, ForceOf&& force_of) const {
+    double acc = 0.0;
+    for (RowSparse::InnerIterator it(stiffness_part_, i); it; ++it) acc += it.value() * x[it.col()];
+    for (RowSparse::InnerIterator it(damping_part_, i); it; ++it) acc += it.value() * u[it.col()];
+    for (RowSparse::InnerIterator it(force_part_, i); it; ++it) acc += it.value() * force_of(it.col());
+    return acc;
   }
   // out = A x (out resized; it must not be x).
   static void band_product(const BandedMatrix& A, const Vector& x, Vector& out) {

@@ -535,21 +535,12 @@ class LocalSwitchCorrection {
       const double f = h / (r + 1);
       double size = 0.0;
       rows_[ru + 1].for_each_row([&](Index i) {
-        double acc = 0.0;
-        for (typename Stepper::RowSparseMatrix::InnerIterator it(st.stiffness_part_, i); it; ++it) acc += it.value() * x[it.col()];
-        for (typename Stepper::RowSparseMatrix::InnerIterator it(st.damping_part_, i); it; ++it) acc += it.value() * u[it.col()];
-        for (typename Stepper::RowSparseMatrix::InnerIterator it(st.force_part_, i); it; ++it) {
-          const Index j = it.col();
-          double p = 0.0;
-          if (mode[j] > 0.0) {
-            double g = 0.0;
-            for (typename Stepper::RowSparseMatrix::InnerIterator w(st.gap_rows_, j); w; ++w) g += w.value() * x[w.col()];
-            p = st.stiffnesses_[j] * g;
-          }
+        const double acc = st.row_acceleration(i, x, u, [&](Index j) {
+          double p = mode[j] > 0.0 ? st.stiffnesses_[j] * st.spring_stretch(j, x) : 0.0;
           const int k = source_row_[static_cast<std::size_t>(j)];
           if (k >= 0 && r < sources_.cols()) p += sources_(k, r);
-          acc += it.value() * p;
-        }
+          return p;
+        });
         x1[i] = f * u[i];
         u1[i] = f * acc;
         size = std::max({size, std::abs(x1[i]), std::abs(u1[i])});
@@ -710,11 +701,7 @@ class LocalSwitchCorrection {
       st.tangent_series(st.eta_, record.terms, 1.0, [&](int r, const Vector& x) {
         tangent_terms_ = r;
         for (Index k = 0; k < sources; ++k) {
-          double g = 0.0;
-          for (typename Stepper::RowSparseMatrix::InnerIterator w(st.gap_rows_, record.sources[static_cast<std::size_t>(k)]); w; ++w) {
-            g += w.value() * x[w.col()];
-          }
-          tangent_gaps_(k, r) = g;
+          tangent_gaps_(k, r) = st.spring_stretch(record.sources[static_cast<std::size_t>(k)], x);
         }
       });
       double scale = std::max(st.tsx_.cwiseAbs().maxCoeff(), st.tsu_.cwiseAbs().maxCoeff());
