@@ -41,6 +41,7 @@ struct OrbitBenchOptions {
   std::vector<long> settle_periods{10000, 60000, 2000};
   std::vector<int> sizes{100, 1000};  // the medium and the large chain
   int points = 200;                   // continuation points per branch
+  std::string corrector = "automatic";  // the continuations' corrector
   std::vector<std::string> cases;     // only these (keys below); empty: all
   std::string out = "out/bench";
   bool quiet = false;
@@ -436,6 +437,9 @@ struct ContinuationRow {
   long points = 0;
   double seconds = 0.0;  // median, s (the first point's Newton included; wall clock)
   double cpu = 0.0;      // median CPU time, s
+  std::string corrector;
+  long monodromies = 0;   // integrations of the map with its monodromy (the last run)
+  long integrations = 0;  // and without
   std::vector<orbits::Bifurcation> bifurcations;
   std::vector<std::string> notes;
   std::string failure;
@@ -474,6 +478,7 @@ ContinuationRow run_continuation(const ContinuationCase& c, const OrbitBenchOpti
   options.max_points = o.points;
   options.method.method = c.method;
   options.shooting.tolerance = o.tolerance;
+  options.corrector = orbits::parse_corrector(o.corrector);
   const analysis::PointModel model(c.chain);
   Vector guess;
   {
@@ -493,6 +498,9 @@ ContinuationRow run_continuation(const ContinuationCase& c, const OrbitBenchOpti
       times.push_back(watch.wall_seconds());
       cpus.push_back(watch.cpu_seconds_since());
       row.points = static_cast<long>(result.points.size());
+      row.corrector = orbits::corrector_name(result.corrector);
+      row.monodromies = result.monodromies;
+      row.integrations = result.integrations;
       row.bifurcations = result.bifurcations;
       row.notes = result.notes;
       if (!result.points.empty()) {
@@ -607,21 +615,22 @@ std::string format_tables(const OrbitBenchOptions& o, const std::vector<Shooting
         "\n\nPseudo-arclength continuation in θ of the period-1 orbit, at most {} points (times: "
         "medians of {} runs, wall clock with the CPU time in parentheses):\n\n",
         o.points, o.repeats);
-    t += "| case | n | method | θ asked | θ reached | points | bifurcations | total s | ms per "
-         "point | why it stopped |\n";
-    t += "|---|---|---|---|---|---|---|---|---|---|\n";
+    t += "| case | n | method | corrector | θ asked | θ reached | points | monodromies / plain "
+         "integrations | bifurcations | total s | ms per point | why it stopped |\n";
+    t += "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const ContinuationRow& r : continuations) {
       if (!r.failure.empty()) {
-        t += fmt::format("| {} | {} | {} | {:g} → {:g} | - | - | - | - | - | failed: {} |\n",
-                         r.label, r.masses, r.method, r.start, r.end, r.failure);
+        t += fmt::format("| {} | {} | {} | {} | {:g} → {:g} | - | - | - | - | - | - | failed: {} |\n",
+                         r.label, r.masses, r.method, r.corrector, r.start, r.end, r.failure);
         continue;
       }
       std::string notes;
       for (const std::string& n : r.notes) notes += (notes.empty() ? "" : "; ") + n;
-      t += fmt::format("| {} | {} | {} ({} tangent) | {:g} → {:g} | {:.4f} ... {:.4f} | {} | {} | "
-                       "{} | {:.3g} | {} |\n",
+      t += fmt::format("| {} | {} | {} ({} tangent) | {} | {:g} → {:g} | {:.4f} ... {:.4f} | {} | "
+                       "{} / {} | {} | {} | {:.3g} | {} |\n",
                        r.label, r.masses, r.method, r.exact_tangent ? "exact" : "finite-difference",
-                       r.start, r.end, r.lowest, r.highest, r.points, bifurcation_list(r, 8),
+                       r.corrector, r.start, r.end, r.lowest, r.highest, r.points, r.monodromies,
+                       r.integrations, bifurcation_list(r, 8),
                        seconds_text(r.seconds, r.cpu), r.points > 0 ? 1e3 * r.seconds / static_cast<double>(r.points) : 0.0,
                        notes);
     }
@@ -650,7 +659,7 @@ void write_csv(const std::string& path, const std::vector<ShootingGroup>& groups
              "brute_distance,brute_more_periods,brute_seconds,brute_cpu_seconds,brute_over_shooting,"
              "theta_start,"
              "theta_end,theta_lowest,theta_highest,points,bifurcations,seconds_per_point,"
-             "bifurcation_list\n");
+             "bifurcation_list,corrector,monodromies,plain_integrations\n");
   for (const ShootingGroup& g : groups) {
     const BruteForce& b = g.brute;
     const std::string status = !b.ran ? "not-run" : b.diverged ? "diverged"
@@ -663,7 +672,7 @@ void write_csv(const std::string& path, const std::vector<ShootingGroup>& groups
       const std::string ratio = comparable ? fmt::format("{:.6g}", b.seconds / r.seconds) : "";
       fmt::print(f,
                  "shooting,{},{},{},{},{},{},{:.6g},{:.6g},{:.6g},{},{},{},{},{},{:.3e},{:.10g},{},{},{},"
-                 "{},{},{:.3e},{:.3e},{:.4g},{:.6g},{:.6g},{},,,,,,,,\n",
+                 "{},{},{:.3e},{:.3e},{:.4g},{:.6g},{:.6g},{},,,,,,,,,,,\n",
                  csv_quoted(r.case_label), r.masses, r.method, r.exact_tangent ? 1 : 0,
                  orbits::shooting_solver_name(r.solver), r.repeats, r.setup, r.seconds, r.cpu,
                  r.converged ? 1 : 0, r.iterations, r.evaluations, r.replays, r.krylov_products, r.residual,
@@ -681,11 +690,12 @@ void write_csv(const std::string& path, const std::vector<ShootingGroup>& groups
     }
     fmt::print(f,
                "continuation,{},{},{},{},dense,{},,{:.6g},{:.6g},{},,,,,,,,,,,,,,,,,,{:.10g},{:.10g},"
-               "{:.10g},{:.10g},{},{},{:.6g},{}\n",
+               "{:.10g},{:.10g},{},{},{:.6g},{},{},{},{}\n",
                csv_quoted(r.label), r.masses, r.method, r.exact_tangent ? 1 : 0, r.repeats,
                r.seconds, r.cpu, r.failure.empty() ? 1 : 0, r.start, r.end, r.lowest, r.highest,
                r.points, r.bifurcations.size(),
-               r.points > 0 ? r.seconds / static_cast<double>(r.points) : 0.0, csv_quoted(list));
+               r.points > 0 ? r.seconds / static_cast<double>(r.points) : 0.0, csv_quoted(list),
+               r.corrector, r.monodromies, r.integrations);
   }
   std::fclose(f);
 }
@@ -805,6 +815,10 @@ void add_orbits_bench(CLI::App& bench) {
   c->add_option("--cases", o->cases,
                 "Only these: 4a, 4a-stable, medium, large, continue-5, continue-medium")
       ->delimiter(',');
+  c->add_option("--corrector", o->corrector,
+                "The continuations' corrector: automatic (newton up to 20 state components, chord\n"
+                "above), chord or newton (the monodromy at every iterate)")
+      ->check(CLI::IsMember({"automatic", "chord", "newton"}));
   c->add_option("--out", o->out, "Folder for bench_orbits.csv and bench_orbits.md");
   c->add_flag("--quiet", o->quiet, "Print only the tables");
   c->callback([o, c] { run(*o, c->count("--repeats") > 0); });

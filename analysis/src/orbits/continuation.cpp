@@ -22,6 +22,23 @@ std::string bifurcation_name(BifurcationType type) {
   return "?";
 }
 
+std::string corrector_name(Corrector corrector) {
+  switch (corrector) {
+    case Corrector::automatic: return "automatic";
+    case Corrector::chord: return "chord";
+    case Corrector::newton: return "newton";
+  }
+  return "?";
+}
+
+Corrector parse_corrector(const std::string& name) {
+  for (Corrector c : {Corrector::automatic, Corrector::chord, Corrector::newton}) {
+    if (corrector_name(c) == name) return c;
+  }
+  throw InputError(
+      fmt::format("corrector = \"{}\" is not known; use automatic, chord or newton", name));
+}
+
 bool ContinuationOptions::is_valid(std::string* why) const {
   std::string scratch;
   if (why == nullptr) why = &scratch;
@@ -141,8 +158,22 @@ struct Point {
   Vector tangent;  // unit tangent (y, p), oriented along the branch
   std::optional<OrbitProfile> profile;
   double residual = 0.0;
-  int iterations = 0;
+  int iterations = 0;  // of the corrector
+  int formed = 0;      // monodromies the corrector formed before it converged
 };
+
+// The chord corrector: a step must shrink the residual at least this much for the monodromy it
+// used to be kept, and a corrector takes at most kChordIterations steps per monodromy allowed.
+constexpr double kChordContraction = 0.25;
+constexpr int kChordIterations = 3;
+// The chord corrector's step control: the predictor's error (∞-norm, relative to max(1, |y|_∞))
+// below which the step grows by 1.5 and above which it shrinks by 0.6. On the 100-mass chain of
+// `pwl bench orbits` this covers θ from 1 to 3 in 199 points, where Newton's rule took 200 points
+// to reach 2.04, with the same grazings; 2e-5 and 2e-4 took 200 points to reach 1.43.
+constexpr double kGrowBelow = 2e-4;
+constexpr double kShrinkAbove = 2e-3;
+// Corrector::automatic takes the chord corrector above this many state components.
+constexpr Index kChordAbove = 20;
 
 class Continuer {
  public:
@@ -165,6 +196,9 @@ class Continuer {
           "continuation forms the {}x{} monodromy; the dense limit is {} state components",
           map.state_size(), map.state_size(), options_.shooting.dense_state_limit));
     }
+    chord_ = options_.corrector == Corrector::chord ||
+             (options_.corrector == Corrector::automatic && map.state_size() > kChordAbove);
+    result_.corrector = chord_ ? Corrector::chord : Corrector::newton;
     ShootingOptions shooting = options_.shooting;
     shooting.solver = ShootingSolver::dense;
     const PeriodicOrbit orbit = find_periodic_orbit(map, guess, shooting);
@@ -217,7 +251,11 @@ class Continuer {
 
   Vector residual(const Vector& y, double p, int period, Matrix* M) {
     StroboscopicMap& map = map_at(p);
-    if (M != nullptr) return map.advance_with_jacobian(y, period, *M) - y;
+    if (M != nullptr) {
+      ++result_.monodromies;
+      return map.advance_with_jacobian(y, period, *M) - y;
+    }
+    ++result_.integrations;
     return map.advance(y, period) - y;
   }
 
@@ -228,10 +266,12 @@ class Continuer {
     return (plus - minus) / (2 * delta);
   }
 
-  // Newton on F(y, p) = 0 with τ · ((y, p) − prediction) = 0, from the prediction itself.
+  // The corrector from the prediction itself, with the monodromy `jacobian` of the point predicted
+  // from.
   std::optional<Point> correct(const Vector& y_pred, double p_pred, const Vector& tau,
-                               const Vector& b, int period) {
-    return correct_from(y_pred, p_pred, y_pred, p_pred, tau, b, period, options_.max_corrections);
+                               const Vector& b, const Matrix* jacobian, int period) {
+    return correct_from(y_pred, p_pred, y_pred, p_pred, tau, b, period, jacobian,
+                        options_.max_corrections);
   }
 
   // The tangent at a corrected point, oriented like `previous`.
@@ -319,7 +359,8 @@ class Continuer {
       const Index N = current.y.size();
       const Vector y_pred = current.y + h * current.tangent.head(N);
       const double p_pred = current.p + h * current.tangent(N);
-      std::optional<Point> next = correct(y_pred, p_pred, current.tangent, current.b, period);
+      std::optional<Point> next =
+          correct(y_pred, p_pred, current.tangent, current.b, &current.M, period);
       if (!next) {
         h /= 2;
         continue;
@@ -396,6 +437,12 @@ class Continuer {
       }
       BranchPoint bp = branch_point(*next, branch, period, arclength);
       emit(bp);
+      // The predictor's error: how far the corrector moved the prediction, relative to the orbit.
+      double predictor_error = std::abs(next->p - p_pred);
+      for (Index i = 0; i < N; ++i) {
+        predictor_error = std::max(predictor_error, std::abs(next->y(i) - y_pred(i)));
+      }
+      predictor_error /= std::max(1.0, next->y.lpNorm<Eigen::Infinity>());
       const int iterations = next->iterations;
       current = std::move(*next);
       if (current.p > hi_ + margin || current.p < lo_ - margin) {
@@ -406,9 +453,16 @@ class Continuer {
       // The largest arclength step: max_step_ in the parameter, up to 100 max_step_ in all.
       const double parameter_share = std::abs(current.tangent(current.tangent.size() - 1));
       const double largest = max_step_ * std::min(1.0 / std::max(parameter_share, 1e-12), 100.0);
-      if (iterations <= 2) h = std::min(1.5 * h, largest);
+      // Newton: the step grows after a corrector of two iterations or fewer and shrinks after
+      // five or more. The chord corrector converges linearly, at a rate set by how far the
+      // monodromy moved since the last point, so its iterations say little about the step: its
+      // step follows the predictor's error e instead, which grows like h² with the branch's
+      // curvature. It grows while e < kGrowBelow and shrinks where e > kShrinkAbove.
+      const bool easy = chord_ ? predictor_error < kGrowBelow : iterations <= 2;
+      const bool hard = chord_ ? predictor_error > kShrinkAbove : iterations >= 5;
+      if (easy) h = std::min(1.5 * h, largest);
       h = std::min(h, largest);
-      if (iterations >= 5) h *= 0.6;
+      if (hard) h *= 0.6;
     }
   }
 
@@ -556,8 +610,12 @@ class Continuer {
       const double p_guess = (1 - w) * pa + w * pb;
       const Vector y_pred = a.y + s * a.tangent.head(N);
       const double p_pred = a.p + s * a.tangent(N);
-      std::optional<Point> pt = correct_from(y_guess, p_guess, y_pred, p_pred, a.tangent, a.b,
-                                             period, options_.max_corrections + 3);
+      // The monodromy interpolated like the guess.
+      const double along = std::clamp(s / h, 0.0, 1.0);
+      const Matrix jacobian = (1 - along) * a.M + along * b.M;
+      std::optional<Point> pt =
+          correct_from(y_guess, p_guess, y_pred, p_pred, a.tangent, a.b, period, &jacobian,
+                       options_.max_corrections + 3, type != BifurcationType::grazing);
       if (!pt) {
         located = false;
         break;
@@ -627,40 +685,83 @@ class Continuer {
   }
 
   // Newton on F(y, p) = 0 with the constraint τ · ((y, p) − (y_pred, p_pred)) = 0, started from
-  // (y_guess, p_guess), at most `corrections` iterations. `b` is ∂F/∂p near the prediction (kept
-  // fixed: the chord in that column only). Empty when it does not converge or the motion blows up.
+  // (y_guess, p_guess). `b` is ∂F/∂p near the prediction (kept fixed: a chord in that column).
+  // Empty when it does not converge or the motion blows up. By default it is the Newton-chord
+  // corrector (Y. A. Kuznetsov 2004, §10.2.2; Allgower and Georg 2003, ch. 2): the bordered
+  // Jacobian keeps the monodromy `jacobian` of a point nearby while the residual contracts by at
+  // least kChordContraction a step, and the monodromy is formed afresh at an iterate where it
+  // does not (at the first one when there is no `jacobian`). Forming the monodromy integrates the map with
+  // all its tangent columns, many times the cost of one integration, so a corrector forms it
+  // about once, at the converged orbit, where its multipliers are wanted anyway. The orbit found
+  // is the one Newton finds, to the same tolerance: only the path to it differs.
+  // `corrections` bounds the monodromies formed before convergence. Without `multipliers` (a
+  // grazing's trial points, whose test function is the orbit's profile) the chord corrector
+  // leaves the orbit's monodromy and multipliers out.
   std::optional<Point> correct_from(const Vector& y_guess, double p_guess, const Vector& y_pred,
                                     double p_pred, const Vector& tau, const Vector& b, int period,
-                                    int corrections) {
+                                    const Matrix* jacobian, int corrections,
+                                    bool multipliers = true) {
     const Index N = y_guess.size();
     Point pt;
     pt.y = y_guess;
     pt.p = p_guess;
-    for (int it = 0; it <= corrections; ++it) {
+    Eigen::PartialPivLU<Matrix> lu;
+    const auto factor = [&](const Matrix& M) {
+      Matrix A(N + 1, N + 1);
+      A.topLeftCorner(N, N) = M - Matrix::Identity(N, N);
+      A.topRightCorner(N, 1) = b;
+      A.bottomRows(1) = tau.transpose();
+      lu.compute(A);
+    };
+    const bool chord = chord_;
+    if (chord && jacobian != nullptr) factor(*jacobian);
+    bool factored = chord && jacobian != nullptr;
+    double previous = std::numeric_limits<double>::infinity();
+    for (int it = 0; it <= kChordIterations * corrections; ++it) {
+      // The monodromy is formed here when there is none yet or the last chord step did not
+      // contract; otherwise only the map is integrated.
       Vector F;
-      try {
-        F = residual(pt.y, pt.p, period, &pt.M);
-      } catch (const Error&) {
-        return std::nullopt;
-      }
-      if (!F.allFinite()) return std::nullopt;
-      const double res = F.lpNorm<Eigen::Infinity>();
+      const auto integrate = [&](bool with_monodromy) {
+        try {
+          F = residual(pt.y, pt.p, period, with_monodromy ? &pt.M : nullptr);
+        } catch (const Error&) {
+          return false;
+        }
+        return F.allFinite();
+      };
+      bool formed = !factored || !chord;
+      if (!integrate(formed)) return std::nullopt;
+      double res = F.lpNorm<Eigen::Infinity>();
       const double constraint = tau.head(N).dot(pt.y - y_pred) + tau(N) * (pt.p - p_pred);
       const double scale = std::max(1.0, pt.y.lpNorm<Eigen::Infinity>());
       if (res <= options_.shooting.tolerance * scale && std::abs(constraint) <= 1e-12 * scale) {
-        pt.residual = res;
         pt.iterations = it;
+        if (!formed && !multipliers) {
+          pt.residual = res;
+          pt.M.resize(0, 0);
+          return pt;
+        }
+        // The monodromy at the orbit, for its multipliers (the same integration, with tangent).
+        if (!formed && !integrate(true)) return std::nullopt;
+        pt.residual = F.lpNorm<Eigen::Infinity>();
         pt.mu = floquet_multipliers(pt.M);
         return pt;
       }
-      Matrix A(N + 1, N + 1);
-      A.topLeftCorner(N, N) = pt.M - Matrix::Identity(N, N);
-      A.topRightCorner(N, 1) = b;
-      A.bottomRows(1) = tau.transpose();
+      if (!formed && !(res <= kChordContraction * previous)) {
+        if (!integrate(true)) return std::nullopt;
+        res = F.lpNorm<Eigen::Infinity>();
+        formed = true;
+      }
+      if (formed) {
+        if (pt.formed++ >= corrections) return std::nullopt;
+        factor(pt.M);
+        factored = true;
+      }
+      previous = res;
       Vector rhs(N + 1);
       rhs.head(N) = -F;
       rhs(N) = -constraint;
-      const Vector d = Eigen::PartialPivLU<Matrix>(A).solve(rhs);
+      const Vector d = lu.solve(rhs);
       if (!d.allFinite()) return std::nullopt;
       pt.y += d.head(N);
       pt.p += d(N);
@@ -689,8 +790,11 @@ class Continuer {
     const Vector b0 = parameter_derivative(pd.at.y, pd.at.p, period);
     for (double eps : {1e-3, 1e-2, 3e-2, 1e-4}) {
       const Vector y_pred = pd.at.y + eps * scale * v;
+      // No monodromy to start from: the period-2k one at the period doubling, M², makes the
+      // bordered matrix singular there (M² − I has v in its kernel, and ∂F/∂p lies in its range:
+      // a pitchfork of the period-2k map), so the first is formed at y* + ε v.
       std::optional<Point> pt = correct_from(y_pred, pd.at.p, y_pred, pd.at.p, tau0, b0, period,
-                                             options_.max_corrections + 3);
+                                             nullptr, options_.max_corrections + 3);
       if (!pt) continue;
       // A genuine period-2k orbit: not a fixed point of the period-k map.
       Vector Fk;
@@ -758,6 +862,7 @@ class Continuer {
   }
 
   const analysis::PointModel& model_;
+  bool chord_ = true;  // the corrector: chord steps, or Newton
   const ContinuationOptions& options_;
   ContinuationObserver* observer_;
   ContinuationResult& result_;

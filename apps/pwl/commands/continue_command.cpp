@@ -518,6 +518,7 @@ ContinuationProblem continuation_problem(const ContinueFlags& f) {
   c.max_step = f.max_step;
   c.max_points = f.max_points;
   c.grazing = !f.no_grazing;
+  c.corrector = orbits::parse_corrector(f.corrector);
   c.switch_branches = f.switch_branches;
   c.max_branches = f.max_branches;
   c.method = method.settings;
@@ -566,6 +567,11 @@ void add_continue_flags(CLI::App& command, ContinueFlags& flags) {
                      "the figures draw the last one. Default: every mass up to 10, else the last")
       ->delimiter(',');
   command.add_flag("--no-grazing", flags.no_grazing, "Do not look for grazing bifurcations");
+  command.add_option("--corrector", flags.corrector,
+                     "chord (Newton steps on the monodromy of the point predicted from, formed\n"
+                     "again only where they stop contracting), newton (the monodromy at every\n"
+                     "iterate) or automatic (newton up to 20 state components, chord above)")
+      ->check(CLI::IsMember({"automatic", "chord", "newton"}));
   command.add_option("--over-sweep", flags.over_sweep,
                      "Also run the brute-force bifurcation diagram of the range (pwl sweep by\n"
                      "continuation, up and down) with this many values into OUT/over_sweep, and "

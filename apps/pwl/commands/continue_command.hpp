@@ -26,6 +26,7 @@ struct ContinueFlags {
   double max_step = 0.0;
   std::vector<std::string> record;
   bool no_grazing = false;
+  std::string corrector = "automatic";
   int over_sweep = 0;
   int over_periods = 100;
   bool no_plot = false;

@@ -11,8 +11,13 @@
 // the parameter turns back) as easily as elsewhere. A step predicts along the unit tangent τ of
 // the branch, (y, p) + h τ, and corrects by Newton on F = 0 with τ · ((y, p) − prediction) = 0,
 // whose bordered Jacobian [M − I, ∂F/∂p; τ^T] is regular at a fold. The monodromy M comes from the
-// map's exact tangent, ∂F/∂p from central differences of the map in p. The step grows after easy
-// corrections and shrinks after hard ones or a turn of the tangent by more than 30°.
+// map's exact tangent, ∂F/∂p from central differences of the map in p. On large structures the
+// corrector is the chord method: it keeps the monodromy of the point it predicted from while the
+// residual falls at least fourfold a step, and forms M again only where it does not, so a point
+// costs about one monodromy (at the orbit, for its multipliers) and a few plain integrations of
+// the map. The step grows after easy corrections (Newton: two iterations or fewer; chord: the
+// corrected point within 2e-4 of the prediction, relative to the state) and shrinks after hard
+// ones or a turn of the tangent by more than 30°.
 //
 // Bifurcations, between two accepted points, from the Floquet multipliers and the orbit's profile:
 //  - fold: a real multiplier crosses +1 (the parity of the real multipliers beyond +1 changes);
@@ -48,6 +53,10 @@
 namespace pwl::orbits {
 
 enum class BifurcationType { fold, period_doubling, neimark_sacker, grazing };
+enum class Corrector { automatic, chord, newton };
+// "automatic", "chord", "newton"; parse_corrector throws InputError naming the value for any other text.
+std::string corrector_name(Corrector corrector);
+Corrector parse_corrector(const std::string& name);
 // "fold", "period-doubling", "neimark-sacker", "grazing".
 std::string bifurcation_name(BifurcationType type);
 
@@ -92,7 +101,12 @@ struct ContinuationOptions {
   // moves fast (near a resonance) is not crawled along. 0: |end − start| / 25.
   double max_step = 0.0;
   int max_points = 2000;      // per branch
-  int max_corrections = 7;    // Newton iterations of one corrector
+  // The corrector: chord steps on the monodromy of the point predicted from, or Newton, which
+  // forms the monodromy at every iterate (the same orbits to the tolerance). Automatic: Newton up
+  // to 20 state components, where a monodromy costs about what an integration does (the exact
+  // solver on the 5-DOF chain), chord above, where it costs its 2n tangent columns.
+  Corrector corrector = Corrector::automatic;
+  int max_corrections = 7;    // monodromies one corrector may form before it converges
   double locate_tolerance = 1e-10;  // of the bifurcation parameters
   bool grazing = true;              // detect grazing
   bool switch_branches = false;     // follow the period-2k branch at each period doubling
@@ -119,6 +133,12 @@ struct ContinuationResult {
   std::vector<BranchPoint> points;        // every branch, in the order computed
   std::vector<Bifurcation> bifurcations;  // in the order found
   std::vector<std::string> notes;         // why each branch stopped
+  // Integrations of the map over the orbit's period: with the monodromy (all its tangent
+  // columns), and without (chord steps, ∂F/∂p, checks). Not counted: the profiles, and the
+  // shooting at the branches' first points.
+  long monodromies = 0;
+  long integrations = 0;
+  Corrector corrector = Corrector::newton;  // the one used (chord or newton)
 };
 
 // Follows the period-k orbit near `guess` (at p = start) toward `end`. Throws InputError for
