@@ -479,6 +479,7 @@ ContinuationRow run_continuation(const ContinuationCase& c, const OrbitBenchOpti
   options.method.method = c.method;
   options.shooting.tolerance = o.tolerance;
   options.corrector = orbits::parse_corrector(o.corrector);
+  row.corrector = o.corrector;  // until a run says which one "automatic" took
   const analysis::PointModel model(c.chain);
   Vector guess;
   {
@@ -620,8 +621,9 @@ std::string format_tables(const OrbitBenchOptions& o, const std::vector<Shooting
     t += "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const ContinuationRow& r : continuations) {
       if (!r.failure.empty()) {
-        t += fmt::format("| {} | {} | {} | {} | {:g} → {:g} | - | - | - | - | - | - | failed: {} |\n",
-                         r.label, r.masses, r.method, r.corrector, r.start, r.end, r.failure);
+        t += fmt::format(
+            "| {} | {} | {} | {} | {:g} → {:g} | - | - | - | - | - | - | failed: {} |\n", r.label,
+            r.masses, r.method, r.corrector, r.start, r.end, r.failure);
         continue;
       }
       std::string notes;

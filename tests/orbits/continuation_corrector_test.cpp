@@ -2,7 +2,8 @@
 // same tolerance, so they must find the same bifurcations (type, spring) at the same parameters
 // to the location tolerance, and every point the chord corrector accepts must be an orbit when
 // checked by a fresh integration of the map. And the chord corrector is there to form fewer
-// monodromies: about one a point, where Newton forms one at every iterate. (The two take different
+// monodromies: about one an accepted point (and one a trial point of a bifurcation other than
+// grazing), where Newton forms one at every iterate. (The two take different
 // steps, so the branches' points differ; their bifurcations do not.)
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -25,6 +26,7 @@ struct Scene {
   double end = 0.0;
   Vector guess;
   bool switch_branches = false;  // onto one period-2 branch, 80 points a branch
+  double step = 0.0;             // initial and largest step (0: the defaults)
 };
 
 // The hysteresis of the hardening gap oscillator (two folds, grazings), θ 0.8 -> 2; figure 4a's
@@ -39,6 +41,10 @@ std::vector<Scene> scenes() {
   const auto points = pwl::test::poincare_points(map, Vector::Zero(10), 300, 2);
   const Vector orbit = find_periodic_orbit(map, 0.5 * (points[0] + points[1])).state;
   s.push_back({"figure 4a", fig4a, 1.2, orbit, true});
+  // A first and largest step of 0.5 in θ: the monodromy of the last point can be far from the
+  // next one's, and the chord steps stall.
+  s.push_back({"gap oscillator, long steps", pwl::test::hardening_oscillator(0.8), 2.0,
+               Vector::Zero(2), false, 0.5});
   return s;
 }
 
@@ -48,6 +54,8 @@ ContinuationResult run(const Scene& scene, Corrector corrector) {
   o.start = scene.chain.theta;
   o.end = scene.end;
   o.corrector = corrector;
+  o.initial_step = scene.step;
+  o.max_step = scene.step;
   if (scene.switch_branches) {
     o.switch_branches = true;
     o.max_branches = 1;
@@ -93,11 +101,15 @@ TEST_CASE("the chord corrector finds Newton's bifurcations with fewer monodromie
     }
     // Monodromies over the whole range, the bifurcations' trial points included: Newton forms one
     // at each iterate, the chord corrector about one a point (and it takes larger steps).
-    INFO("chord: " << chord.monodromies << " monodromies, " << chord.integrations
-                   << " integrations, " << chord.points.size() << " points; newton: "
-                   << newton.monodromies << ", " << newton.integrations << ", "
-                   << newton.points.size());
+    INFO("chord: " << chord.monodromies << " monodromies, " << chord.chord_stalls << " stalls, "
+                   << chord.integrations << " integrations, " << chord.points.size()
+                   << " points; newton: " << newton.monodromies << ", " << newton.integrations
+                   << ", " << newton.points.size());
     CHECK(chord.monodromies < 0.5 * static_cast<double>(newton.monodromies));
+    // The chord corrector's step follows the predictor's error and grows where Newton's would not.
+    if (scene.step == 0) CHECK(chord.points.size() < newton.points.size());
+    // Where the chord steps stall, the monodromy is formed again.
+    if (scene.step > 0) CHECK(chord.chord_stalls > 0);
   }
 }
 

@@ -610,12 +610,16 @@ class Continuer {
       const double p_guess = (1 - w) * pa + w * pb;
       const Vector y_pred = a.y + s * a.tangent.head(N);
       const double p_pred = a.p + s * a.tangent(N);
-      // The monodromy interpolated like the guess.
-      const double along = std::clamp(s / h, 0.0, 1.0);
-      const Matrix jacobian = (1 - along) * a.M + along * b.M;
+      // The chord corrector starts from the monodromy interpolated like the guess.
+      Matrix jacobian;
+      if (chord_) {
+        const double along = std::clamp(s / h, 0.0, 1.0);
+        jacobian = (1 - along) * a.M + along * b.M;
+      }
       std::optional<Point> pt =
-          correct_from(y_guess, p_guess, y_pred, p_pred, a.tangent, a.b, period, &jacobian,
-                       options_.max_corrections + 3, type != BifurcationType::grazing);
+          correct_from(y_guess, p_guess, y_pred, p_pred, a.tangent, a.b, period,
+                       chord_ ? &jacobian : nullptr, options_.max_corrections + 3,
+                       type != BifurcationType::grazing);
       if (!pt) {
         located = false;
         break;
@@ -684,19 +688,23 @@ class Continuer {
     return std::abs(x) < std::abs(y);
   }
 
-  // Newton on F(y, p) = 0 with the constraint τ · ((y, p) − (y_pred, p_pred)) = 0, started from
-  // (y_guess, p_guess). `b` is ∂F/∂p near the prediction (kept fixed: a chord in that column).
-  // Empty when it does not converge or the motion blows up. By default it is the Newton-chord
-  // corrector (Y. A. Kuznetsov 2004, §10.2.2; Allgower and Georg 2003, ch. 2): the bordered
-  // Jacobian keeps the monodromy `jacobian` of a point nearby while the residual contracts by at
-  // least kChordContraction a step, and the monodromy is formed afresh at an iterate where it
-  // does not (at the first one when there is no `jacobian`). Forming the monodromy integrates the map with
-  // all its tangent columns, many times the cost of one integration, so a corrector forms it
-  // about once, at the converged orbit, where its multipliers are wanted anyway. The orbit found
-  // is the one Newton finds, to the same tolerance: only the path to it differs.
-  // `corrections` bounds the monodromies formed before convergence. Without `multipliers` (a
-  // grazing's trial points, whose test function is the orbit's profile) the chord corrector
-  // leaves the orbit's monodromy and multipliers out.
+  // The corrector: F(y, p) = 0 with the constraint τ · ((y, p) − (y_pred, p_pred)) = 0, solved
+  // from (y_guess, p_guess). `b` is ∂F/∂p near the prediction (kept fixed: a chord in that
+  // column). Empty when it does not converge or the motion blows up.
+  //
+  // Newton forms the monodromy at every iterate. The Newton-chord corrector (the default above
+  // 20 state components; Y. A. Kuznetsov 2004, §10.2.2; Allgower and Georg 2003, ch. 2) keeps
+  // the monodromy `jacobian` of a point nearby (the point predicted from, or between the two ends
+  // of a bifurcation's bracket the monodromy interpolated like the guess) while the residual falls
+  // at least kChordContraction a step. Where it does not, the monodromy is formed afresh, at the
+  // last iterate if the step made the residual larger and at the new one otherwise (at the first
+  // one when there is no `jacobian`). Forming the monodromy integrates the map with all its
+  // tangent columns, many times the cost of one integration, so a corrector forms it about once,
+  // at the orbit it converges to, where its multipliers are wanted. The orbit found is the one
+  // Newton finds, to the same tolerance: only the path to it differs. `corrections` bounds the
+  // monodromies formed before convergence. Without `multipliers` (a grazing's trial points, whose
+  // test function is the orbit's profile) the chord corrector leaves the orbit's monodromy and
+  // multipliers out.
   std::optional<Point> correct_from(const Vector& y_guess, double p_guess, const Vector& y_pred,
                                     double p_pred, const Vector& tau, const Vector& b, int period,
                                     const Matrix* jacobian, int corrections,
@@ -717,6 +725,8 @@ class Continuer {
     if (chord && jacobian != nullptr) factor(*jacobian);
     bool factored = chord && jacobian != nullptr;
     double previous = std::numeric_limits<double>::infinity();
+    Vector last_y = pt.y;  // the iterate whose residual is `previous`
+    double last_p = pt.p;
     for (int it = 0; it <= kChordIterations * corrections; ++it) {
       // The monodromy is formed here when there is none yet or the last chord step did not
       // contract; otherwise only the map is integrated.
@@ -732,7 +742,10 @@ class Continuer {
       bool formed = !factored || !chord;
       if (!integrate(formed)) return std::nullopt;
       double res = F.lpNorm<Eigen::Infinity>();
-      const double constraint = tau.head(N).dot(pt.y - y_pred) + tau(N) * (pt.p - p_pred);
+      const auto constraint_at = [&] {
+        return tau.head(N).dot(pt.y - y_pred) + tau(N) * (pt.p - p_pred);
+      };
+      double constraint = constraint_at();
       const double scale = std::max(1.0, pt.y.lpNorm<Eigen::Infinity>());
       if (res <= options_.shooting.tolerance * scale && std::abs(constraint) <= 1e-12 * scale) {
         pt.iterations = it;
@@ -748,9 +761,17 @@ class Continuer {
         return pt;
       }
       if (!formed && !(res <= kChordContraction * previous)) {
+        // The chord step stalled: the monodromy here, or back where the step started if it made
+        // the residual larger.
+        if (!(res <= previous)) {
+          pt.y = last_y;
+          pt.p = last_p;
+          constraint = constraint_at();
+        }
         if (!integrate(true)) return std::nullopt;
         res = F.lpNorm<Eigen::Infinity>();
         formed = true;
+        ++result_.chord_stalls;
       }
       if (formed) {
         if (pt.formed++ >= corrections) return std::nullopt;
@@ -758,6 +779,8 @@ class Continuer {
         factored = true;
       }
       previous = res;
+      last_y = pt.y;
+      last_p = pt.p;
       Vector rhs(N + 1);
       rhs.head(N) = -F;
       rhs(N) = -constraint;

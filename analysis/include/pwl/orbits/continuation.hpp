@@ -13,11 +13,12 @@
 // whose bordered Jacobian [M − I, ∂F/∂p; τ^T] is regular at a fold. The monodromy M comes from the
 // map's exact tangent, ∂F/∂p from central differences of the map in p. On large structures the
 // corrector is the chord method: it keeps the monodromy of the point it predicted from while the
-// residual falls at least fourfold a step, and forms M again only where it does not, so a point
-// costs about one monodromy (at the orbit, for its multipliers) and a few plain integrations of
-// the map. The step grows after easy corrections (Newton: two iterations or fewer; chord: the
-// corrected point within 2e-4 of the prediction, relative to the state) and shrinks after hard
-// ones or a turn of the tangent by more than 30°.
+// residual falls at least fourfold a step, and forms M again only where it does not, so an
+// accepted point costs about one monodromy (at the orbit, for its multipliers) and a few plain
+// integrations of the map (a bifurcation's trial points one more each, a grazing's none). The
+// step grows after easy corrections (Newton: two iterations or fewer; chord: the corrected point
+// within 2e-4 of the prediction, relative to the state) and shrinks after hard ones or a turn of
+// the tangent by more than 30°.
 //
 // Bifurcations, between two accepted points, from the Floquet multipliers and the orbit's profile:
 //  - fold: a real multiplier crosses +1 (the parity of the real multipliers beyond +1 changes);
@@ -54,7 +55,8 @@ namespace pwl::orbits {
 
 enum class BifurcationType { fold, period_doubling, neimark_sacker, grazing };
 enum class Corrector { automatic, chord, newton };
-// "automatic", "chord", "newton"; parse_corrector throws InputError naming the value for any other text.
+// "automatic", "chord", "newton"; parse_corrector throws InputError naming the value for any
+// other text.
 std::string corrector_name(Corrector corrector);
 Corrector parse_corrector(const std::string& name);
 // "fold", "period-doubling", "neimark-sacker", "grazing".
@@ -138,6 +140,7 @@ struct ContinuationResult {
   // shooting at the branches' first points.
   long monodromies = 0;
   long integrations = 0;
+  long chord_stalls = 0;  // chord steps that stalled, after which the monodromy was formed again
   Corrector corrector = Corrector::newton;  // the one used (chord or newton)
 };
 
