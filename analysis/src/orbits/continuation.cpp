@@ -148,6 +148,16 @@ double product_shifted(const FloquetMultipliers& mu, double target) {
   return product.real();
 }
 
+// The bordered Jacobian of pseudo-arclength continuation, [M − I, b; row^T]: regular at a fold.
+Matrix bordered(const Matrix& M, const Vector& b, const Vector& row) {
+  const Index N = M.rows();
+  Matrix A(N + 1, N + 1);
+  A.topLeftCorner(N, N) = M - Matrix::Identity(N, N);
+  A.topRightCorner(N, 1) = b;
+  A.bottomRows(1) = row.transpose();
+  return A;
+}
+
 // A point being built: (y, p) and what was computed there.
 struct Point {
   Vector y;   // state
@@ -277,13 +287,9 @@ class Continuer {
   // The tangent at a corrected point, oriented like `previous`.
   Vector tangent_at(const Point& pt, const Vector& previous) {
     const Index N = pt.y.size();
-    Matrix A(N + 1, N + 1);
-    A.topLeftCorner(N, N) = pt.M - Matrix::Identity(N, N);
-    A.topRightCorner(N, 1) = pt.b;
-    A.bottomRows(1) = previous.transpose();
     Vector rhs = Vector::Zero(N + 1);
     rhs(N) = 1.0;
-    Vector z = Eigen::PartialPivLU<Matrix>(A).solve(rhs);
+    Vector z = Eigen::PartialPivLU<Matrix>(bordered(pt.M, pt.b, previous)).solve(rhs);
     z /= z.norm();
     if (z.dot(previous) < 0) z = -z;
     return z;
@@ -438,11 +444,9 @@ class Continuer {
       BranchPoint bp = branch_point(*next, branch, period, arclength);
       emit(bp);
       // The predictor's error: how far the corrector moved the prediction, relative to the orbit.
-      double predictor_error = std::abs(next->p - p_pred);
-      for (Index i = 0; i < N; ++i) {
-        predictor_error = std::max(predictor_error, std::abs(next->y(i) - y_pred(i)));
-      }
-      predictor_error /= std::max(1.0, next->y.lpNorm<Eigen::Infinity>());
+      const double predictor_error =
+          std::max((next->y - y_pred).lpNorm<Eigen::Infinity>(), std::abs(next->p - p_pred)) /
+          std::max(1.0, next->y.lpNorm<Eigen::Infinity>());
       const int iterations = next->iterations;
       current = std::move(*next);
       if (current.p > hi_ + margin || current.p < lo_ - margin) {
@@ -714,37 +718,30 @@ class Continuer {
     pt.y = y_guess;
     pt.p = p_guess;
     Eigen::PartialPivLU<Matrix> lu;
-    const auto factor = [&](const Matrix& M) {
-      Matrix A(N + 1, N + 1);
-      A.topLeftCorner(N, N) = M - Matrix::Identity(N, N);
-      A.topRightCorner(N, 1) = b;
-      A.bottomRows(1) = tau.transpose();
-      lu.compute(A);
-    };
-    const bool chord = chord_;
-    if (chord && jacobian != nullptr) factor(*jacobian);
-    bool factored = chord && jacobian != nullptr;
+    bool factored = chord_ && jacobian != nullptr;
+    if (factored) lu.compute(bordered(*jacobian, b, tau));
     double previous = std::numeric_limits<double>::infinity();
     Vector last_y = pt.y;  // the iterate whose residual is `previous`
     double last_p = pt.p;
+    Vector F;
+    // F at the iterate, with the monodromy there or without; false where the motion blows up.
+    const auto integrate = [&](bool with_monodromy) {
+      try {
+        F = residual(pt.y, pt.p, period, with_monodromy ? &pt.M : nullptr);
+      } catch (const Error&) {
+        return false;
+      }
+      return F.allFinite();
+    };
+    const auto constraint_at = [&] {
+      return tau.head(N).dot(pt.y - y_pred) + tau(N) * (pt.p - p_pred);
+    };
     for (int it = 0; it <= kChordIterations * corrections; ++it) {
       // The monodromy is formed here when there is none yet or the last chord step did not
       // contract; otherwise only the map is integrated.
-      Vector F;
-      const auto integrate = [&](bool with_monodromy) {
-        try {
-          F = residual(pt.y, pt.p, period, with_monodromy ? &pt.M : nullptr);
-        } catch (const Error&) {
-          return false;
-        }
-        return F.allFinite();
-      };
-      bool formed = !factored || !chord;
+      bool formed = !factored || !chord_;
       if (!integrate(formed)) return std::nullopt;
       double res = F.lpNorm<Eigen::Infinity>();
-      const auto constraint_at = [&] {
-        return tau.head(N).dot(pt.y - y_pred) + tau(N) * (pt.p - p_pred);
-      };
       double constraint = constraint_at();
       const double scale = std::max(1.0, pt.y.lpNorm<Eigen::Infinity>());
       if (res <= options_.shooting.tolerance * scale && std::abs(constraint) <= 1e-12 * scale) {
@@ -775,7 +772,7 @@ class Continuer {
       }
       if (formed) {
         if (pt.formed++ >= corrections) return std::nullopt;
-        factor(pt.M);
+        lu.compute(bordered(pt.M, b, tau));
         factored = true;
       }
       previous = res;
