@@ -1,4 +1,5 @@
-// Orbits found by shooting on the exact solver, checked by an independent integrator: the
+// Orbits found by shooting on the exact solver and on the switching PIM (the method for large
+// structures), checked by an independent integrator: the
 // kink-located rkf78 at tolerance 1e-13 (every step ends at a spring switch, so it keeps its
 // order). Started on the orbit it must come back to it after k periods, and the Floquet
 // multipliers from Richardson-extrapolated central differences of its flow (no tangent map at all)
@@ -25,14 +26,16 @@ MethodSettings reference_method() {
   return m;
 }
 
+// `closure`: how far rkf78 may carry the orbit from itself in k periods, the orbit's own method's
+// error included.
 void check_with_reference(StroboscopicMap& reference, const PeriodicOrbit& orbit,
-                          const std::string& label) {
+                          const std::string& label, double closure_tolerance = 1e-10) {
   INFO(label);
   CHECK_FALSE(reference.exact_tangent());
   const double closure =
       (reference.advance(orbit.state, orbit.period) - orbit.state).lpNorm<Eigen::Infinity>();
   measured(label + ": |rkf78(y*) - y*|", closure);
-  CHECK(closure <= 1e-10);
+  CHECK(closure <= closure_tolerance);
   // h = 1e-3: the O(h⁴) truncation (~1e-10 here) and rkf78's noise amplified by 1/h (~1e-10)
   // balance.
   const Matrix M = pwl::test::central_differences(reference, orbit.state, orbit.period, 1e-3, true);
@@ -64,4 +67,30 @@ TEST_CASE("figure 4a's periodic orbits close under kink-located rkf78 at 1e-13",
   REQUIRE(one.residual <= 1e-12);
   CHECK(one.multipliers.largest_modulus() > 2);  // unstable: rkf78's error grows 2.2x per period
   check_with_reference(reference, one, "4a period-1");
+}
+
+TEST_CASE("the switching PIM's periodic orbits close under kink-located rkf78 at 1e-13",
+          "[orbits]") {
+  // The method orbits of large structures are found with (above 20 masses): the higher-order PIM
+  // with located switches, 200 steps a period, its exact tangent giving the monodromy. The same
+  // two orbits of figure 4a, checked by the same independent integration. The PIM's own
+  // truncation error over a period, not its Newton, sets how far rkf78 carries its orbits
+  // (measured 1.5e-10 over the period-2 orbit's two periods): they must close to 1e-9.
+  const NondimensionalChain chain = paper_five_dof_case("4a");
+  StroboscopicMap switching(analysis::PointCase(chain), MethodSettings{Method::pim_switching}, 200);
+  REQUIRE(switching.exact_tangent());
+  StroboscopicMap reference(analysis::PointCase(chain), reference_method(), 1);
+  const auto points = pwl::test::poincare_points(switching, Vector::Zero(10), 500, 2);
+  ShootingOptions options;
+  options.tolerance = 1e-13;
+  options.period = 2;
+  const PeriodicOrbit two = find_periodic_orbit(switching, points.back(), options);
+  REQUIRE(two.residual <= 1e-12);
+  check_with_reference(reference, two, "switching PIM, 4a period-2", 1e-9);
+  options.period = 1;
+  const PeriodicOrbit one =
+      find_periodic_orbit(switching, 0.5 * (points[0] + points[1]), options);
+  REQUIRE(one.residual <= 1e-12);
+  CHECK(one.multipliers.largest_modulus() > 2);
+  check_with_reference(reference, one, "switching PIM, 4a period-1", 1e-9);
 }

@@ -132,6 +132,7 @@ class ContinueOutputs : public orbits::ContinuationObserver {
   std::vector<std::string> bifurcation_columns() const {
     std::vector<std::string> c = bifurcation_header();
     for (int i : dofs_) c.push_back(fmt::format("amplitude_x{}", i + 1));
+    for (int i : dofs_) c.push_back(fmt::format("x{}", i + 1));
     return c;
   }
 
@@ -232,6 +233,8 @@ class ContinueOutputs : public orbits::ContinuationObserver {
     for (int i : dofs_) {
       add_field(row, std::isfinite(amplitude(i)) ? number(amplitude(i)) : std::string());
     }
+    // Its state at t = 0 mod T, one of its Poincaré points, for the marks over the diagram.
+    for (int i : dofs_) add_field(row, number(b.state(i)));
     return row;
   }
 
@@ -294,6 +297,17 @@ void print_bifurcations(const std::vector<orbits::Bifurcation>& all, const std::
   }
 }
 
+// How many of each kind were found, as gnuplot definitions, so that a figure's legend names only
+// the kinds found.
+std::string bifurcation_counts(const std::vector<orbits::Bifurcation>& found) {
+  std::map<orbits::BifurcationType, int> kinds;
+  for (const orbits::Bifurcation& b : found) ++kinds[b.type];
+  return fmt::format(
+      "nfold = {}; ndoubling = {}; nns = {}; ngrazing = {}; ", kinds[orbits::BifurcationType::fold],
+      kinds[orbits::BifurcationType::period_doubling],
+      kinds[orbits::BifurcationType::neimark_sacker], kinds[orbits::BifurcationType::grazing]);
+}
+
 void draw_frequency_response(const ContinueFlags& f, const ContinueOutputs& outputs,
                              const std::vector<orbits::Bifurcation>& found,
                              const std::vector<int>& dofs, const analysis::SweepParameter& parameter,
@@ -306,13 +320,7 @@ void draw_frequency_response(const ContinueFlags& f, const ContinueOutputs& outp
     periods += fmt::format("bp{} = {}; ", branch, period);
     last_branch = std::max(last_branch, branch);
   }
-  // How many of each kind, so that the legend names only the kinds found.
-  std::map<orbits::BifurcationType, int> kinds;
-  for (const orbits::Bifurcation& b : found) ++kinds[b.type];
-  const std::string counts = fmt::format(
-      "nfold = {}; ndoubling = {}; nns = {}; ngrazing = {}; ", kinds[orbits::BifurcationType::fold],
-      kinds[orbits::BifurcationType::period_doubling],
-      kinds[orbits::BifurcationType::neimark_sacker], kinds[orbits::BifurcationType::grazing]);
+  const std::string counts = bifurcation_counts(found);
   const auto definitions = [&](const std::string& format) {
     return fmt::format(
         "branch='{0}/branch.csv'; bifurcations='{0}/bifurcations.csv'; out='{0}/"
@@ -331,7 +339,7 @@ void draw_frequency_response(const ContinueFlags& f, const ContinueOutputs& outp
 void run_over_sweep(const ContinueFlags& f, const analysis::PointModel& model,
                     const analysis::SweepParameter& parameter, const OrbitMethod& method,
                     double from, double to, const std::vector<int>& dofs,
-                    const std::string& title) {
+                    const std::vector<orbits::Bifurcation>& found, const std::string& title) {
   const int dof = dofs.back();  // the figures draw the last recorded mass
   analysis::SweepOptions o;
   if (model.explicit_structure()) {
@@ -367,14 +375,17 @@ void run_over_sweep(const ContinueFlags& f, const analysis::PointModel& model,
              run.out);
   run_sweep(o, run, f.orbit.out);
   if (f.no_plot) return;
+  const int recorded = static_cast<int>(dofs.size());
+  const std::string counts = bifurcation_counts(found);
   const auto definitions = [&](const std::string& format) {
     return fmt::format(
         "poincare='{0}/bifurcation_points.csv'; section='{1}/branch_section.csv'; column=5; "
-        "scolumn={2}; out='{1}/branch_over_diagram.{3}'; xname={4}; yname={5}; title={6}",
-        run.out, f.orbit.out, 5 + static_cast<int>(dofs.size()), format, gnuplot_quoted(parameter_label(parameter)),
+        "scolumn={2}; bifurcations='{1}/bifurcations.csv'; bxcolumn={7}; {8}"
+        "out='{1}/branch_over_diagram.{3}'; xname={4}; yname={5}; title={6}",
+        run.out, f.orbit.out, 5 + recorded, format, gnuplot_quoted(parameter_label(parameter)),
         gnuplot_quoted(fmt::format("x_{} at t = kT{}", dof + 1,
                                    model.explicit_structure() ? "" : " (nondimensional)")),
-        gnuplot_quoted(title));
+        gnuplot_quoted(title), 9 + 2 * recorded, counts);
   };
   draw_figure_and_report(scripts_directory() + "/branch_over_diagram.gp", definitions,
                          f.orbit.out + "/branch_over_diagram", "pwl continue", false);
@@ -450,7 +461,7 @@ void continue_orbit(const ContinueFlags& f) {
                             !base.explicit_structure(), title);
   }
   if (f.over_sweep > 0) {
-    run_over_sweep(f, base, parameter, method, from, to, dofs, title);
+    run_over_sweep(f, base, parameter, method, from, to, dofs, result.bifurcations, title);
   }
 }
 

@@ -96,8 +96,15 @@ void orbit(const OrbitCommandFlags& f) {
   }
   fmt::print("amplitude max|x{}| over the orbit: {:.10g}\n", n, profile.amplitude(n - 1));
   const int outside = mu.unstable_count();
-  fmt::print("verdict: {} ({} multiplier{} outside the unit circle)\n",
-             orbit.stable() ? "stable" : "unstable", outside, outside == 1 ? "" : "s");
+  if (!mu.converged) {
+    // Arnoldi's leading multipliers did not meet their tolerance: no verdict from them.
+    fmt::print("verdict: undetermined (Arnoldi did not converge: residual {:.1e}; {} of its "
+               "multipliers outside the unit circle)\n",
+               mu.residual, outside);
+  } else {
+    fmt::print("verdict: {} ({} multiplier{} outside the unit circle)\n",
+               orbit.stable() ? "stable" : "unstable", outside, outside == 1 ? "" : "s");
+  }
   fmt::print("time: {:.3f} s\n", seconds);
   fmt::print("wrote {0}/orbit.csv, {0}/floquet.csv{1}\n", o.out,
              path ? fmt::format(" and {}/orbit_path.csv", o.out) : std::string());
