@@ -9,14 +9,14 @@
 # (its column drawn, 5 = the first recorded component), section (branch_section.csv:
 # parameter,branch,period,stable,iterate,components), scolumn (the same component's column there),
 # bifurcations (bifurcations.csv of pwl continue), bxcolumn (the same component's column there),
-# nfold, ndoubling, nns, ngrazing (how many of each kind: a kind not found stays out of the
-# legend), out, fmt, xname, yname, title.
+# nfold, ndoubling, nns, ngrazing (as bifurcation_marks.gp takes them), out, fmt, xname, yname,
+# title.
 if (!exists("poincare")) poincare = 'continuation/over_sweep/bifurcation_points.csv'
 if (!exists("column")) column = 5
 if (!exists("section")) section = 'continuation/branch_section.csv'
 if (!exists("scolumn")) scolumn = 10
 if (!exists("bifurcations")) bifurcations = 'continuation/bifurcations.csv'
-if (!exists("bxcolumn")) bxcolumn = 11
+if (!exists("bxcolumn")) bxcolumn = 19
 if (!exists("nfold")) nfold = 0
 if (!exists("ndoubling")) ndoubling = 0
 if (!exists("nns")) nns = 0
@@ -33,11 +33,9 @@ set ylabel yname
 set key outside right top
 set grid
 set autoscale xfix
-mark(kind, pt, color, name) = sprintf(", bifurcations using 2:(strcol(1) eq '%s' ? column(bxcolumn) : NaN) with points pt %d ps 1.6 lw 2 lc rgb '%s' title '%s'", kind, pt, color, name)
-marks = (nfold > 0 ? mark('fold', 9, '#000000', 'fold') : '') . \
-        (ndoubling > 0 ? mark('period-doubling', 5, '#d62728', 'period doubling') : '') . \
-        (nns > 0 ? mark('neimark-sacker', 13, '#ff7f0e', 'Neimark-Sacker') : '') . \
-        (ngrazing > 0 ? mark('grazing', 2, '#2ca02c', 'grazing') : '')
+mcolumn = bxcolumn
+msize = 1.6
+load 'bifurcation_marks.gp'
 plot poincare using 1:(column(column)) with points pt 7 ps 0.15 lc rgb '#9a9a9a' notitle, \
      section using 1:($4 == 1 ? column(scolumn) : NaN) with points pt 7 ps 0.4 lc rgb '#08306b' \
        notitle, \

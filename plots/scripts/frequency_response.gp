@@ -44,11 +44,9 @@ restart(row) = row == 0 ? (pb = -1, ps = -1) : 0
 pb = -1
 ps = -1
 # The bifurcations, each kind with its own mark, only the kinds found.
-mark(kind, pt, color, name) = sprintf(", bifurcations using 2:(strcol(1) eq '%s' ? column(bcolumn) : NaN) with points pt %d ps 2 lw 2 lc rgb '%s' title '%s'", kind, pt, color, name)
-marks = (nfold > 0 ? mark('fold', 9, '#000000', 'fold') : '') . \
-        (ndoubling > 0 ? mark('period-doubling', 5, '#d62728', 'period doubling') : '') . \
-        (nns > 0 ? mark('neimark-sacker', 13, '#ff7f0e', 'Neimark-Sacker') : '') . \
-        (ngrazing > 0 ? mark('grazing', 2, '#2ca02c', 'grazing') : '')
+mcolumn = bcolumn
+msize = 2
+load 'bifurcation_marks.gp'
 plot for [b=0:branches-1] branch using 2:(restart($0), keep($1, $4, 1) && $1 == b ? column(ycolumn) : NaN) \
        with lines lw 2 dt 1 lc rgb bcolor(b) \
        title sprintf('branch %d (period %d), stable', b, period_of(b)), \

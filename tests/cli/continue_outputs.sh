@@ -1,7 +1,8 @@
 #!/bin/sh
 # pwl continue on a small range writes branch.csv, bifurcations.csv and branch_section.csv with
-# their headers (bifurcations.csv with the orbit's amplitudes and state of the recorded masses), one row of branch.csv per point and as many section rows as the points' periods
-# add up to; then pwl sweep --branches draws those branches over its own diagram.
+# their headers (bifurcations.csv with the orbit's amplitudes and state of the recorded masses),
+# one row of branch.csv per point and as many section rows as the points' periods add up to; then
+# pwl sweep --branches draws those branches over its own diagram.
 # With --switch-branches in the continuation flags, a period-2 branch must be among them.
 # Usage: continue_outputs.sh PWL OUTPUT_FOLDER "CASE FLAGS" PARAMETER RANGE "CONTINUE FLAGS"
 #                            BRANCH_HEADER
@@ -33,13 +34,19 @@ fi
 # After the detail: the orbit's amplitudes and its state at t = 0 of the recorded masses, the same
 # columns as branch.csv's, each a number.
 bif_tail=$(head -n 1 "$out/continue/bifurcations.csv" | cut -d, -f10-)
-branch_middle=$(echo "$branch_header" | awk -F, '{ for (i = 6; i < NF; i++) printf "%s%s", $i, (i < NF - 1 ? "," : "") }')
+branch_middle=$(echo "$branch_header" |
+  awk -F, '{ for (i = 6; i < NF; i++) printf "%s%s", $i, (i < NF - 1 ? "," : "") }')
 if [ "$bif_tail" != "$branch_middle" ]; then
   echo "bifurcations.csv columns after detail: '$bif_tail', expected '$branch_middle'"
   fail=1
 fi
-awk -F, 'NR > 1 { for (i = 10; i <= NF; i++) if ($i !~ /^-?[0-9]/) { print "bifurcations.csv row " NR ": column " i " is \"" $i "\""; bad = 1 } }
-  END { exit bad }' "$out/continue/bifurcations.csv" || fail=1
+# Every row as wide as the header, and at least one (both ranges tested hold bifurcations).
+awk -F, 'NR == 1 { width = NF; next }
+  NF != width { print "bifurcations.csv row " NR ": " NF " columns, not " width; bad = 1 }
+  { for (i = 10; i <= NF; i++) if ($i !~ /^-?[0-9]/) {
+      print "bifurcations.csv row " NR ": column " i " is \"" $i "\""; bad = 1 } }
+  END { if (NR < 2) { print "bifurcations.csv: no bifurcation"; bad = 1 }; exit bad }' \
+  "$out/continue/bifurcations.csv" || fail=1
 points=$(($(wc -l < "$out/continue/branch.csv") - 1))
 sections=$(awk -F, 'NR > 1 { k += $3 } END { print k + 0 }' "$out/continue/branch.csv")
 section_rows=$(($(wc -l < "$out/continue/branch_section.csv") - 1))

@@ -1,10 +1,9 @@
 // Orbits found by shooting on the exact solver and on the switching PIM (the method for large
-// structures), checked by an independent integrator: the
-// kink-located rkf78 at tolerance 1e-13 (every step ends at a spring switch, so it keeps its
-// order). Started on the orbit it must come back to it after k periods, and the Floquet
-// multipliers from Richardson-extrapolated central differences of its flow (no tangent map at all)
-// must be those of the exact tangent. Figure 4a's chain: the unstable period-1 orbit and the
-// stable period-2 orbit the paper shows.
+// structures), checked by an independent integrator: the kink-located rkf78 at tolerance 1e-13
+// (every step ends at a spring switch, so it keeps its order). Started on the orbit it must come
+// back to it after k periods, and the Floquet multipliers from Richardson-extrapolated central
+// differences of its flow (no tangent map at all) must be those of the exact tangent. Figure
+// 4a's chain: the unstable period-1 orbit and the stable period-2 orbit the paper shows.
 #include <catch2/catch.hpp>
 #include <string>
 
@@ -26,8 +25,8 @@ MethodSettings reference_method() {
   return m;
 }
 
-// `closure`: how far rkf78 may carry the orbit from itself in k periods, the orbit's own method's
-// error included.
+// `closure_tolerance`: how far rkf78 may carry the orbit from itself in k periods, the orbit's own
+// method's error included.
 void check_with_reference(StroboscopicMap& reference, const PeriodicOrbit& orbit,
                           const std::string& label, double closure_tolerance = 1e-10) {
   INFO(label);

@@ -184,9 +184,10 @@ constexpr double kGrowBelow = 2e-4;
 constexpr double kShrinkAbove = 2e-3;
 // Corrector::automatic takes the chord corrector above this many state components.
 constexpr Index kChordAbove = 20;
-// A bifurcation's trial points are closed to this residual (relative, as the shooting tolerance),
-// or to the rounding floor where that is higher: the corrector goes on past the shooting
-// tolerance until a step no longer shrinks the residual fourfold. An orbit closed to a residual r
+// A bifurcation's trial points are closed to this residual (relative, as the shooting tolerance)
+// where the corrector gets there: past the shooting tolerance it goes on while each step shrinks
+// the residual fourfold (so it stops at the rounding floor, or where a chord step contracts
+// more slowly), keeping the best iterate within the tolerance. An orbit closed to a residual r
 // places a test function to about r over its slope, and a gap's extreme can change slowly with
 // the parameter: on the 100-mass chain of `pwl bench orbits` beyond θ = 2.6, grazings located on
 // orbits closed to 1e-10 were off by up to 8.9e-8, and on orbits closed to 1e-12 they agreed
@@ -631,8 +632,7 @@ class Continuer {
       std::optional<Point> pt =
           correct_from(y_guess, p_guess, y_pred, p_pred, a.tangent, a.b, period,
                        chord_ ? &jacobian : nullptr, options_.max_corrections + 3,
-                       type != BifurcationType::grazing,
-                       std::min(kLocateResidual, options_.shooting.tolerance));
+                       type != BifurcationType::grazing, kLocateResidual);
       if (!pt) {
         located = false;
         break;
@@ -718,8 +718,10 @@ class Continuer {
   // monodromies formed before convergence. Without `multipliers` (a grazing's trial points, whose
   // test function is the orbit's profile) the chord corrector leaves the orbit's monodromy and
   // multipliers out. A `polish` below the shooting tolerance (a bifurcation's trial points) closes
-  // the orbit further: to `polish`, or, past the shooting tolerance, until a step no longer
-  // shrinks the residual kChordContraction-fold (the rounding floor).
+  // the orbit further: to `polish`, or, past the shooting tolerance, while each step shrinks the
+  // residual kChordContraction-fold (to the rounding floor, or until a chord step contracts more
+  // slowly). It returns the best iterate within the shooting tolerance where polishing ends on a
+  // worse one or runs out of monodromies or steps.
   std::optional<Point> correct_from(const Vector& y_guess, double p_guess, const Vector& y_pred,
                                     double p_pred, const Vector& tau, const Vector& b, int period,
                                     const Matrix* jacobian, int corrections,
@@ -749,18 +751,47 @@ class Continuer {
     const auto constraint_at = [&] {
       return tau.head(N).dot(pt.y - y_pred) + tau(N) * (pt.p - p_pred);
     };
+    // While polishing: the iterate with the smallest residual among those already within the
+    // shooting tolerance (and on the constraint). Returned when polishing ends on a worse one or
+    // runs out of monodromies or steps, so that polishing never loses an orbit the tolerance
+    // accepts.
+    struct Within {
+      Vector y;
+      double p = 0.0, res = 0.0;
+      int it = 0;
+    };
+    std::optional<Within> within;
+    const auto fall_back = [&]() -> std::optional<Point> {
+      if (!within) return std::nullopt;
+      pt.y = within->y;
+      pt.p = within->p;
+      pt.iterations = within->it;
+      pt.residual = within->res;
+      pt.M.resize(0, 0);
+      if (!multipliers) return pt;
+      if (!integrate(true)) return std::nullopt;
+      pt.residual = F.lpNorm<Eigen::Infinity>();
+      pt.mu = floquet_multipliers(pt.M);
+      return pt;
+    };
     for (int it = 0; it <= kChordIterations * corrections; ++it) {
       // The monodromy is formed here when there is none yet or the last chord step did not
       // contract; otherwise only the map is integrated.
       bool formed = !factored || !chord_;
-      if (!integrate(formed)) return std::nullopt;
+      if (!integrate(formed)) return fall_back();
       double res = F.lpNorm<Eigen::Infinity>();
       double constraint = constraint_at();
       const double scale = std::max(1.0, pt.y.lpNorm<Eigen::Infinity>());
+      const bool on_constraint = std::abs(constraint) <= 1e-12 * scale;
       const bool closed =
           res <= polish * scale ||
           (res <= tolerance * scale && !(res <= kChordContraction * previous));
-      if (closed && std::abs(constraint) <= 1e-12 * scale) {
+      if (closed && on_constraint && within && within->res < res) return fall_back();
+      if (polish < tolerance && res <= tolerance * scale && on_constraint &&
+          !(within && within->res <= res)) {
+        within = Within{pt.y, pt.p, res, it};
+      }
+      if (closed && on_constraint) {
         pt.iterations = it;
         if (!formed && !multipliers) {
           pt.residual = res;
@@ -781,13 +812,13 @@ class Continuer {
           pt.p = last_p;
           constraint = constraint_at();
         }
-        if (!integrate(true)) return std::nullopt;
+        if (!integrate(true)) return fall_back();
         res = F.lpNorm<Eigen::Infinity>();
         formed = true;
         ++result_.chord_stalls;
       }
       if (formed) {
-        if (pt.formed++ >= corrections) return std::nullopt;
+        if (pt.formed++ >= corrections) return fall_back();
         lu.compute(bordered(pt.M, b, tau));
         factored = true;
       }
@@ -798,15 +829,15 @@ class Continuer {
       rhs.head(N) = -F;
       rhs(N) = -constraint;
       const Vector d = lu.solve(rhs);
-      if (!d.allFinite()) return std::nullopt;
+      if (!d.allFinite()) return fall_back();
       pt.y += d.head(N);
       pt.p += d(N);
       std::string why;
       if (!std::isfinite(pt.p) || !model_.accepts(options_.parameter, pt.p, &why)) {
-        return std::nullopt;
+        return fall_back();
       }
     }
-    return std::nullopt;
+    return fall_back();
   }
 
   void switch_branch(Pending& pd) {

@@ -33,10 +33,11 @@
 // Each is located by the Illinois variant of regula falsi on the arclength between the two points
 // (every trial point corrected onto the branch) on a test function that vanishes there: the real
 // multiplier nearest ±1 minus ±1, the modulus of the complex pair nearest the circle minus 1, the
-// extreme gap. The parameter is located to `locate_tolerance`, on trial points closed to 1e-12
-// (or the shooting tolerance if tighter), or to rounding where that is higher: an orbit closed to
-// a residual r places the test function to about r over its slope, and a gap's extreme can move
-// slowly with the parameter.
+// extreme gap. The parameter is located to `locate_tolerance`, on trial points closed past the
+// shooting tolerance, to 1e-12 (or the shooting tolerance if tighter) where the corrector gets
+// there while each step shrinks the residual fourfold: an orbit closed to a residual r places the
+// test function to about r over its slope, and a gap's extreme can move slowly with the
+// parameter.
 //
 // Branch switching: at a period doubling of a period-k branch, the period-2k branch passes through
 // the same point with the tangent (v, 0), v the eigenvector of the multiplier −1 (Y. A. Kuznetsov,
