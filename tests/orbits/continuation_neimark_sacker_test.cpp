@@ -19,11 +19,7 @@ using pwl::test::measured;
 
 namespace {
 
-NondimensionalChain chain_at(double theta) {
-  NondimensionalChain c = paper_five_dof_case("5");
-  c.theta = theta;
-  return c;
-}
+NondimensionalChain chain_at(double theta) { return pwl::test::paper_case_at("5", theta); }
 
 PeriodicOrbit orbit_at(double theta, const Vector& guess) {
   StroboscopicMap map(analysis::PointCase(chain_at(theta)), MethodSettings{Method::exact}, 1);

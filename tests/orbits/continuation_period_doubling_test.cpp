@@ -17,11 +17,7 @@ using pwl::test::measured;
 
 namespace {
 
-NondimensionalChain chain_at(double theta) {
-  NondimensionalChain c = paper_five_dof_case("4a");
-  c.theta = theta;
-  return c;
-}
+NondimensionalChain chain_at(double theta) { return pwl::test::paper_case_at("4a", theta); }
 
 // The real multiplier nearest −1 of the period-1 orbit at θ (Newton from `guess`, updated).
 double multiplier_near_minus_one(double theta, Vector& guess) {

@@ -48,24 +48,31 @@ void check_with_reference(StroboscopicMap& reference, const PeriodicOrbit& orbit
   CHECK(multipliers <= 1e-9);
 }
 
-}  // namespace
-
-TEST_CASE("figure 4a's periodic orbits close under kink-located rkf78 at 1e-13", "[orbits]") {
-  const NondimensionalChain chain = paper_five_dof_case("4a");
-  StroboscopicMap exact(analysis::PointCase(chain), MethodSettings{Method::exact}, 1);
-  StroboscopicMap reference(analysis::PointCase(chain), reference_method(), 1);
-  const auto points = pwl::test::poincare_points(exact, Vector::Zero(10), 500, 2);
+// Figure 4a's stable period-2 orbit and its unstable period-1 orbit, found by shooting on `map`
+// from its Poincaré points after 500 periods, then checked against rkf78 (`label`: the method).
+void check_figure_4a_orbits(StroboscopicMap& map, const std::string& label,
+                            double closure_tolerance) {
+  StroboscopicMap reference(analysis::PointCase(paper_five_dof_case("4a")), reference_method(), 1);
+  const auto points = pwl::test::poincare_points(map, Vector::Zero(10), 500, 2);
   ShootingOptions options;
   options.tolerance = 1e-13;
   options.period = 2;
-  const PeriodicOrbit two = find_periodic_orbit(exact, points.back(), options);
+  const PeriodicOrbit two = find_periodic_orbit(map, points.back(), options);
   REQUIRE(two.residual <= 1e-12);
-  check_with_reference(reference, two, "4a period-2");
+  check_with_reference(reference, two, label + "4a period-2", closure_tolerance);
   options.period = 1;
-  const PeriodicOrbit one = find_periodic_orbit(exact, 0.5 * (points[0] + points[1]), options);
+  const PeriodicOrbit one = find_periodic_orbit(map, 0.5 * (points[0] + points[1]), options);
   REQUIRE(one.residual <= 1e-12);
   CHECK(one.multipliers.largest_modulus() > 2);  // unstable: rkf78's error grows 2.2x per period
-  check_with_reference(reference, one, "4a period-1");
+  check_with_reference(reference, one, label + "4a period-1", closure_tolerance);
+}
+
+}  // namespace
+
+TEST_CASE("figure 4a's periodic orbits close under kink-located rkf78 at 1e-13", "[orbits]") {
+  StroboscopicMap exact(analysis::PointCase(paper_five_dof_case("4a")),
+                        MethodSettings{Method::exact}, 1);
+  check_figure_4a_orbits(exact, "", 1e-10);
 }
 
 TEST_CASE("the switching PIM's periodic orbits close under kink-located rkf78 at 1e-13",
@@ -75,21 +82,8 @@ TEST_CASE("the switching PIM's periodic orbits close under kink-located rkf78 at
   // two orbits of figure 4a, checked by the same independent integration. The PIM's own
   // truncation error over a period, not its Newton, sets how far rkf78 carries its orbits
   // (measured 1.5e-10 over the period-2 orbit's two periods): they must close to 1e-9.
-  const NondimensionalChain chain = paper_five_dof_case("4a");
-  StroboscopicMap switching(analysis::PointCase(chain), MethodSettings{Method::pim_switching}, 200);
+  StroboscopicMap switching(analysis::PointCase(paper_five_dof_case("4a")),
+                            MethodSettings{Method::pim_switching}, 200);
   REQUIRE(switching.exact_tangent());
-  StroboscopicMap reference(analysis::PointCase(chain), reference_method(), 1);
-  const auto points = pwl::test::poincare_points(switching, Vector::Zero(10), 500, 2);
-  ShootingOptions options;
-  options.tolerance = 1e-13;
-  options.period = 2;
-  const PeriodicOrbit two = find_periodic_orbit(switching, points.back(), options);
-  REQUIRE(two.residual <= 1e-12);
-  check_with_reference(reference, two, "switching PIM, 4a period-2", 1e-9);
-  options.period = 1;
-  const PeriodicOrbit one =
-      find_periodic_orbit(switching, 0.5 * (points[0] + points[1]), options);
-  REQUIRE(one.residual <= 1e-12);
-  CHECK(one.multipliers.largest_modulus() > 2);
-  check_with_reference(reference, one, "switching PIM, 4a period-1", 1e-9);
+  check_figure_4a_orbits(switching, "switching PIM, ", 1e-9);
 }

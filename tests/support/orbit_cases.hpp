@@ -51,6 +51,13 @@ inline NondimensionalChain one_mass(double alpha, double zeta, double gap, doubl
 // The hardening gap oscillator of the continuation-sweep test (tests/study/parameter_sweep_test):
 // one mass of the nondimensional chain, α = 3, ζ = 0.1, Δ̃ = 1.5, Q = 0.5; its resonance bends to
 // higher θ once the mass reaches the gap, with two folds and hysteresis between them.
+// One of the paper's 5-DOF cases ("4a", "4b", "5", "6") at the forcing frequency θ.
+inline NondimensionalChain paper_case_at(const std::string& figure, double theta) {
+  NondimensionalChain c = paper_five_dof_case(figure);
+  c.theta = theta;
+  return c;
+}
+
 inline NondimensionalChain hardening_oscillator(double theta) {
   return one_mass(3.0, 0.1, 1.5, 0.5, theta);
 }
