@@ -295,3 +295,49 @@ TEST_CASE("Products over row ranges, with a bound check, and by listed columns",
   CHECK((t1 - expected).cwiseAbs().maxCoeff() < 1e-13);
   CHECK((t2 - expected).cwiseAbs().maxCoeff() < 1e-13);
 }
+
+namespace {
+
+// A rectangular operator of a chain of `cells` cells: 2 rows per cell (interleaved state), 3
+// columns per cell (springs), band from the cell's columns; rows repeat with the cell except in
+// the first 4 and the last 3 cells, whose entries depend on the distance to the end.
+Matrix periodic_operator(Index cells) {
+  Matrix A = Matrix::Zero(2 * cells, 3 * cells);
+  for (Index c = 0; c < cells; ++c) {
+    for (Index a = 0; a < 2; ++a) {
+      for (Index j = std::max<Index>(0, 3 * (c - 2)); j < std::min<Index>(3 * cells, 3 * (c + 3)); ++j) {
+        double v = std::sin(1.0 + 3.0 * a + 0.7 * static_cast<double>(j - 3 * c));
+        if (c < 4) v += 0.1 * static_cast<double>(4 - c);
+        if (c >= cells - 3) v -= 0.05 * static_cast<double>(c - cells + 4);
+        A(2 * c + a, j) = v;
+      }
+    }
+  }
+  return A;
+}
+
+}  // namespace
+
+TEST_CASE("Repeating a period of rows lays out the longer operator exactly", "[banded][period]") {
+  // The short operator of 20 cells with periods of cells 9..10 inserted 7 times at cell 10 is the
+  // operator of 34 cells (a 2-cell period: two copies of 2 cells of rows each... here one cell
+  // repeats, so a period of 2 cells is also a period).
+  const Index short_cells = 20, cut = 10, period = 2, copies = 7;
+  const BandedMatrix A = BandedMatrix::from_dense_nonzeros(periodic_operator(short_cells));
+  const AxisRepeat rows{2 * cut, 2 * period, copies}, cols{3 * cut, 3 * period, copies};
+  const BandedMatrix B = repeat_period(A, rows, cols);
+  const Matrix expected = periodic_operator(short_cells + period * copies);
+  REQUIRE(B.rows() == expected.rows());
+  REQUIRE(B.cols() == expected.cols());
+  CHECK((B.to_dense() - expected).cwiseAbs().maxCoeff() == 0.0);
+  // No row computed or stored again; products over the segments read the layout.
+  CHECK(B.stored_rows() == A.stored_rows());
+  const Vector x = Vector::LinSpaced(B.cols(), -1.0, 2.0);
+  CHECK((B * x - expected * x).cwiseAbs().maxCoeff() <= 1e-14);
+  // An axis without rows in the period (no spring in the repeated cells) inserts nothing.
+  const BandedMatrix C = repeat_period(A, {2 * cut, 0, copies}, {3 * cut, 3 * period, copies});
+  CHECK(C.rows() == A.rows());
+  CHECK(C.cols() == A.cols() + 3 * period * copies);
+  // A period that does not fit before the cut is refused.
+  CHECK_THROWS_AS(repeat_period(A, {2, 4, 1}, {3, 6, 1}), Error);
+}

@@ -2,6 +2,13 @@
 // 39(7) (2018) 737-749 (eqs 8-14 and 20-22), built from the banded exponential.
 #include "pwl/integrators/banded_step_operators.hpp"
 
+#include <optional>
+#include <string>
+
+#include "banded/periodic_cut.hpp"
+#include "pwl/errors.hpp"
+#include "pwl/numerics/substructure_exponential.hpp"
+
 #include <algorithm>
 #include <numeric>
 
@@ -18,25 +25,25 @@ std::vector<Index> springs_by_position(const GapStructure& structure) {
     const Index a = s.dof, b = s.other_dof >= 0 ? s.other_dof : s.dof;
     return std::pair{std::min(a, b), std::max(a, b)};
   };
-  std::stable_sort(order.begin(), order.end(),
-                   [&](Index a, Index b) { return position(a) < position(b); });
+  const auto before = [&](Index a, Index b) { return position(a) < position(b); };
+  // Builders list a chain's springs in order: one pass instead of a sort.
+  if (!std::is_sorted(order.begin(), order.end(), before)) {
+    std::stable_sort(order.begin(), order.end(), before);
+  }
   return order;
 }
 
-BandedStepOperators make_banded_step_operators(const GapStructure& structure, double step,
-                                               const BandedExponentialOptions& options) {
-  BandedExponential e = make_banded_exponential(structure, step, options);
+namespace {
+
+// The springs in spring_order: their gaps and stiffnesses, K2 W^T, and G_v = -M⁻¹W (the velocity
+// rows of G), returned.
+SparseMatrix set_springs(const GapStructure& structure, BandedStepOperators& ops) {
   const Index n = structure.dofs();
   const Index m = structure.spring_count();
-
-  BandedStepOperators ops;
-  ops.step = step;
-  ops.truncation = e.truncation;
   ops.spring_order = springs_by_position(structure);
   ops.gaps.resize(m);
   ops.stiffnesses.resize(m);
-  // W in spring_order, and G_v = -M⁻¹W (the velocity rows of G).
-  std::vector<Eigen::Triplet<double>> w, g, k2wt;
+  std::vector<Eigen::Triplet<double>> g, k2wt;
   const Vector mass = structure.mass.diagonal();
   for (Index j = 0; j < m; ++j) {
     const GapSpring& s = structure.springs[static_cast<std::size_t>(
@@ -54,7 +61,17 @@ BandedStepOperators make_banded_step_operators(const GapStructure& structure, do
   G.setFromTriplets(g.begin(), g.end());
   ops.gap_rows.resize(m, n);
   ops.gap_rows.setFromTriplets(k2wt.begin(), k2wt.end());
+  return G;
+}
 
+// Every row from its substructure.
+BandedStepOperators build_row_by_row(const GapStructure& structure, double step,
+                                     const BandedExponentialOptions& options) {
+  BandedExponential e = make_banded_exponential(structure, step, options);
+  BandedStepOperators ops;
+  ops.step = step;
+  ops.truncation = e.truncation;
+  const SparseMatrix G = set_springs(structure, ops);
   ops.transition = std::move(e.transition);
   ops.force_next = multiply(e.rising_load, G);
   ops.force_now = multiply(e.falling_load, G);
@@ -62,8 +79,46 @@ BandedStepOperators make_banded_step_operators(const GapStructure& structure, do
   // I - K2 W^T Φ_x, with Φ_x the displacement (even) rows of Φ.
   const BandedMatrix phi_x = select_rows(ops.force_next, 0, 2);
   const SparseMatrix minus_gap_rows = -ops.gap_rows;
-  ops.lcp_matrix = add_diagonal(multiply(minus_gap_rows, phi_x), Vector::Ones(m));
+  ops.lcp_matrix = add_diagonal(multiply(minus_gap_rows, phi_x), Vector::Ones(structure.spring_count()));
   return ops;
+}
+
+}  // namespace
+
+BandedStepOperators make_banded_step_operators(const GapStructure& structure, double step,
+                                               const BandedExponentialOptions& options) {
+  std::string why;
+  if (!options.is_valid(&why)) throw InputError("banded exponential options: " + why);
+  structure.validate();
+  BandedExponentialOptions band = options;
+  if (band.cell_dofs == 0) band.cell_dofs = detect_cell_size(structure);
+  // Construction from the period (periodic_cut.hpp): the banded operators of a short chain laid
+  // out over this one; the springs' sparse parts are this structure's own.
+  std::optional<BandedStepOperators> laid_out =
+      banded_detail::build_from_period<BandedStepOperators>(
+          structure, band,
+          [&](const GapStructure& short_chain) { return build_row_by_row(short_chain, step, band); },
+          [&](const BandedStepOperators& built, const banded_detail::PeriodicCut& cut,
+              const AxisRepeat& springs) {
+            const AxisRepeat state = banded_detail::axis_repeat(cut, 2 * cut.cut, 2 * cut.period);
+            BandedStepOperators ops;
+            ops.step = step;
+            ops.truncation = built.truncation;
+            ops.truncation.blocks += cut.removed / built.truncation.cell_dofs;
+            ops.truncation.laid_out = cut.removed;
+            set_springs(structure, ops);
+            ops.transition = repeat_period(built.transition, state, state);
+            ops.force_next = repeat_period(built.force_next, state, springs);
+            ops.force_now = repeat_period(built.force_now, state, springs);
+            for (const HarmonicResponse& h : built.harmonics) {
+              ops.harmonics.push_back({h.omega, banded_detail::repeat_period(h.sin_response, state),
+                                       banded_detail::repeat_period(h.cos_response, state)});
+            }
+            ops.lcp_matrix = repeat_period(built.lcp_matrix, springs, springs);
+            return ops;
+          });
+  if (laid_out) return std::move(*laid_out);
+  return build_row_by_row(structure, step, band);
 }
 
 }  // namespace pwl

@@ -736,4 +736,45 @@ BandedMatrix transpose(const BandedMatrix& A) {
   return b.build();
 }
 
+BandedMatrix repeat_period(const BandedMatrix& A, const AxisRepeat& rows, const AxisRepeat& cols) {
+  if (rows.before < rows.period || rows.before > A.rows() || rows.period < 0 ||
+      rows.copies < 0 || cols.before > A.cols() || cols.period < 0 ||
+      cols.copies != rows.copies) {
+    throw Error(fmt::format(
+        "banded matrix: cannot repeat rows [{}, {}) of a {}x{} matrix {} times ({} columns a "
+        "period, {} copies)",
+        rows.before - rows.period, rows.before, A.rows(), A.cols(), rows.copies, cols.period,
+        cols.copies));
+  }
+  BandedMatrix out;
+  out.rows_ = A.rows_ + rows.inserted();
+  out.cols_ = A.cols_ + cols.inserted();
+  out.width_ = A.width_;
+  out.values_ = A.values_;
+  const auto size = static_cast<std::size_t>(out.rows_);
+  out.first_.resize(size);
+  out.pool_index_.resize(size);
+  const auto before = static_cast<std::size_t>(rows.before);
+  std::copy_n(A.first_.begin(), before, out.first_.begin());
+  std::copy_n(A.pool_index_.begin(), before, out.pool_index_.begin());
+  for (Index k = 0; k < rows.copies; ++k) {
+    const Index shift = (k + 1) * cols.period;
+    for (Index phase = 0; phase < rows.period; ++phase) {
+      const auto from = static_cast<std::size_t>(rows.before - rows.period + phase);
+      const auto to = static_cast<std::size_t>(rows.before + k * rows.period + phase);
+      out.first_[to] = A.first_[from] + shift;
+      out.pool_index_[to] = A.pool_index_[from];
+    }
+  }
+  const Index after = A.rows_ - rows.before;
+  for (Index r = 0; r < after; ++r) {
+    const auto from = static_cast<std::size_t>(rows.before + r);
+    const auto to = static_cast<std::size_t>(rows.before + rows.inserted() + r);
+    out.first_[to] = A.first_[from] + cols.inserted();
+    out.pool_index_[to] = A.pool_index_[from];
+  }
+  out.find_segments();
+  return out;
+}
+
 }  // namespace pwl

@@ -20,6 +20,9 @@ struct RowBlock {
 // periodic structure; the rows near each end form one block whose substructure holds that end.
 std::vector<RowBlock> partition_rows(Index n, Index margin, Index cell);
 
+// Whether column j + p of A is column j shifted down by p (rows and values).
+bool shifted_column_matches(const SparseMatrix& A, Index j, Index p);
+
 // Which windows repeat exactly the window `shift()` degrees of freedom before them, found in
 // O(non-zeros) once, so that the blocks of a periodic stretch reuse an earlier block's
 // substructure without building and hashing a SubstructureKey each (what made the assembly's

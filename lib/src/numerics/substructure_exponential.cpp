@@ -37,7 +37,10 @@ Matrix principal_block(const SparseMatrix& A, Index first, Index last) {
   return B;
 }
 
-// Whether column j + p of A is column j shifted down by p.
+}  // namespace
+
+namespace banded_detail {
+
 bool shifted_column_matches(const SparseMatrix& A, Index j, Index p) {
   SparseMatrix::InnerIterator a(A, j), b(A, j + p);
   for (; a && b; ++a, ++b) {
@@ -46,7 +49,7 @@ bool shifted_column_matches(const SparseMatrix& A, Index j, Index p) {
   return !a && !b;
 }
 
-}  // namespace
+}  // namespace banded_detail
 
 SubstructureKey::SubstructureKey(const GapStructure& structure, Index first, Index last,
                                  const std::vector<LoadGroup>& loads) {
@@ -156,7 +159,9 @@ Index detect_cell_size(const GapStructure& structure, Index max_cell) {
     if (hi - lo < 2 * p) break;  // too short to tell
     bool periodic = true;
     for (const SparseMatrix* A : {&structure.mass, &structure.damping, &structure.stiffness}) {
-      for (Index j = lo; j < hi && periodic; ++j) periodic = shifted_column_matches(*A, j, p);
+      for (Index j = lo; j < hi && periodic; ++j) {
+        periodic = banded_detail::shifted_column_matches(*A, j, p);
+      }
       if (!periodic) break;
     }
     if (periodic) return p;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <unordered_map>
 #include <vector>
 
@@ -22,6 +23,7 @@
 #include "pwl/numerics/substructure_exponential.hpp"
 #include "pwl/numerics/state_checks.hpp"
 #include "numerics/row_blocks.hpp"
+#include "banded/periodic_cut.hpp"
 #include "switching/local_switch_correction.hpp"
 #include "switching/switching_pim_detail.hpp"
 
@@ -121,6 +123,112 @@ std::vector<BandedMatrix> banded_force_coefficients(const GapStructure& s, doubl
   return out;
 }
 
+// W with its columns in springs_by_position order, and the springs' gaps and stiffnesses in that
+// order.
+struct SortedSprings {
+  SparseMatrix directions;
+  Vector gaps, stiffnesses;
+};
+
+SortedSprings sorted_springs(const GapStructure& s) {
+  const Index m = s.spring_count();
+  const std::vector<Index> order = springs_by_position(s);
+  SortedSprings out{SparseMatrix(s.dofs(), m), Vector(m), Vector(m)};
+  std::vector<Eigen::Triplet<double>> w;
+  for (Index j = 0; j < m; ++j) {
+    const GapSpring& g = s.springs[static_cast<std::size_t>(order[static_cast<std::size_t>(j)])];
+    out.gaps[j] = g.gap;
+    out.stiffnesses[j] = g.stiffness;
+    w.emplace_back(g.dof, j, g.direction);
+    if (g.other_dof >= 0) w.emplace_back(g.other_dof, j, -g.direction);
+  }
+  out.directions.setFromTriplets(w.begin(), w.end());
+  return out;
+}
+
+// diag(scale) A, in O(non-zeros) (Eigen's diagonal-times-sparse assignment inserts entry by
+// entry).
+SparseMatrix scaled_rows(const SparseMatrix& A, const Vector& scale) {
+  SparseMatrix B = A;
+  for (Index j = 0; j < B.outerSize(); ++j) {
+    for (SparseMatrix::InnerIterator it(B, j); it; ++it) it.valueRef() *= scale[it.row()];
+  }
+  return B;
+}
+
+// -M⁻¹ W, the accelerations of unit spring forces (a diagonal mass).
+SparseMatrix spring_accelerations(const GapStructure& s, const SparseMatrix& W) {
+  return scaled_rows(W, -s.mass.diagonal().cwiseInverse());
+}
+
+// The step's banded operators of one structure (the members of BandedStepper below).
+struct StepOperatorSet {
+  BandTruncation truncation;
+  BandedMatrix transition;
+  std::vector<HarmonicResponse> harmonics;
+  std::vector<BandedMatrix> correction, correction_columns;
+  BandedMatrix phi, phi_columns, slope, slope_columns;
+  BandedMatrix lcp;  // I - K2 W^T Φ_x (not yet checked to be a P-matrix)
+};
+
+// Row by row from the substructures: T and the harmonic responses from the banded exponential,
+// the force coefficients from the same substructures, their products with -M⁻¹W, and the LCP.
+StepOperatorSet build_step_operators(const GapStructure& s, double eta, int d, bool end,
+                                     const BandedExponentialOptions& band) {
+  StepOperatorSet out;
+  BandedExponential e = make_banded_exponential(s, eta, band);
+  out.truncation = e.truncation;
+  out.transition = std::move(e.transition);
+  out.harmonics = std::move(e.harmonics);
+  if (s.spring_count() == 0) return out;
+  const SortedSprings springs = sorted_springs(s);
+  const SparseMatrix force_part = spring_accelerations(s, springs.directions);
+  const std::vector<BandedMatrix> unit =
+      banded_force_coefficients(s, eta, d, end, out.truncation.band, out.truncation.margin,
+                                out.truncation.cell_dofs, band);
+  const std::size_t corrections = unit.size() - 2;
+  for (std::size_t r = 0; r < corrections; ++r) {
+    out.correction.push_back(multiply(unit[r], force_part));
+    out.correction_columns.push_back(transpose(out.correction.back()));
+  }
+  out.phi = multiply(unit[corrections], force_part);
+  out.phi_columns = transpose(out.phi);
+  out.slope = multiply(unit[corrections + 1], force_part);
+  out.slope_columns = transpose(out.slope);
+  const SparseMatrix minus_spring_rows =
+      scaled_rows(SparseMatrix(springs.directions.transpose()), -springs.stiffnesses);
+  out.lcp = add_diagonal(multiply(minus_spring_rows, select_rows(out.phi, 0, 2)),
+                         Vector::Ones(s.spring_count()));
+  return out;
+}
+
+// The operators of a long chain from those of the short chain of `cut` (periodic_cut.hpp).
+StepOperatorSet repeat_period(const StepOperatorSet& o, const banded_detail::PeriodicCut& cut,
+                              const AxisRepeat& springs) {
+  const AxisRepeat state = banded_detail::axis_repeat(cut, 2 * cut.cut, 2 * cut.period);
+  StepOperatorSet out;
+  out.truncation = o.truncation;
+  // One row block (a cell) per inserted cell.
+  if (o.truncation.cell_dofs > 0) out.truncation.blocks += cut.removed / o.truncation.cell_dofs;
+  out.truncation.laid_out = cut.removed;
+  out.transition = repeat_period(o.transition, state, state);
+  for (const HarmonicResponse& h : o.harmonics) {
+    out.harmonics.push_back({h.omega, banded_detail::repeat_period(h.sin_response, state),
+                             banded_detail::repeat_period(h.cos_response, state)});
+  }
+  for (std::size_t r = 0; r < o.correction.size(); ++r) {
+    out.correction.push_back(repeat_period(o.correction[r], state, springs));
+    out.correction_columns.push_back(repeat_period(o.correction_columns[r], springs, state));
+  }
+  if (o.lcp.rows() == 0) return out;
+  out.phi = repeat_period(o.phi, state, springs);
+  out.phi_columns = repeat_period(o.phi_columns, springs, state);
+  out.slope = repeat_period(o.slope, state, springs);
+  out.slope_columns = repeat_period(o.slope_columns, springs, state);
+  out.lcp = repeat_period(o.lcp, springs, springs);
+  return out;
+}
+
 struct LoadTerm {
   double omega;
   Vector sin_part;  // M⁻¹ times the load's sin part
@@ -143,28 +251,13 @@ class BandedStepper final : public SwitchingPim,
         correction_mode_(options.switch_correction), solver_(options.lcp) {
     // Sparse parts of the equation of motion, springs by position along the structure.
     const Vector inverse_mass = s.mass.diagonal().cwiseInverse();
-    const std::vector<Index> order = springs_by_position(s);
-    gaps_.resize(m_);
-    stiffnesses_.resize(m_);
-    std::vector<Eigen::Triplet<double>> w;
-    for (Index j = 0; j < m_; ++j) {
-      const GapSpring& g = s.springs[static_cast<std::size_t>(order[static_cast<std::size_t>(j)])];
-      gaps_[j] = g.gap;
-      stiffnesses_[j] = g.stiffness;
-      w.emplace_back(g.dof, j, g.direction);
-      if (g.other_dof >= 0) w.emplace_back(g.other_dof, j, -g.direction);
-    }
-    SparseMatrix W(n_, m_);
-    W.setFromTriplets(w.begin(), w.end());
-    SparseMatrix minus_inverse_mass(n_, n_);
-    {
-      std::vector<Eigen::Triplet<double>> diag;
-      for (Index i = 0; i < n_; ++i) diag.emplace_back(i, i, -inverse_mass[i]);
-      minus_inverse_mass.setFromTriplets(diag.begin(), diag.end());
-    }
-    stiffness_part_ = RowSparse(minus_inverse_mass * s.stiffness);
-    damping_part_ = RowSparse(minus_inverse_mass * s.damping);
-    const SparseMatrix force_part = minus_inverse_mass * W;
+    SortedSprings springs = sorted_springs(s);
+    const SparseMatrix& W = springs.directions;
+    gaps_ = std::move(springs.gaps);
+    stiffnesses_ = std::move(springs.stiffnesses);
+    stiffness_part_ = RowSparse(scaled_rows(s.stiffness, -inverse_mass));
+    damping_part_ = RowSparse(scaled_rows(s.damping, -inverse_mass));
+    const SparseMatrix force_part = spring_accelerations(s, W);
     force_part_ = RowSparse(force_part);
     gap_rows_ = RowSparse(SparseMatrix(W.transpose()));
     spring_rows_ = RowSparse(stiffnesses_.asDiagonal() * gap_rows_);
@@ -214,38 +307,38 @@ class BandedStepper final : public SwitchingPim,
     }
 
     // T, the harmonic responses and the band from the banded exponential; the force
-    // coefficients from the same substructures.
+    // coefficients from the same substructures; from the period where the chain's middle
+    // repeats, row by row otherwise.
     BandedExponentialOptions band = options.band;
     if (band.cell_dofs == 0) band.cell_dofs = detect_cell_size(s);
-    BandedExponential e = make_banded_exponential(s, eta_, band);
-    truncation_ = e.truncation;
-    transition_ = std::move(e.transition);
-    harmonics_ = std::move(e.harmonics);
+    std::optional<StepOperatorSet> from_period = banded_detail::build_from_period<StepOperatorSet>(
+        s, band,
+        [&](const GapStructure& short_chain) {
+          return build_step_operators(short_chain, eta_, d_, end_derivative_, band);
+        },
+        [](const StepOperatorSet& built, const banded_detail::PeriodicCut& cut,
+           const AxisRepeat& springs) { return repeat_period(built, cut, springs); });
+    diagnostics_.from_period = from_period.has_value();
+    StepOperatorSet ops = from_period ? std::move(*from_period)
+                                      : build_step_operators(s, eta_, d_, end_derivative_, band);
+    truncation_ = ops.truncation;
+    transition_ = std::move(ops.transition);
+    harmonics_ = std::move(ops.harmonics);
     if (m_ > 0) {
-      const std::vector<BandedMatrix> unit = banded_force_coefficients(
-          s, eta_, d_, end_derivative_, truncation_.band, truncation_.margin,
-          truncation_.cell_dofs, band);
-      const std::size_t corrections = unit.size() - 2;
-      for (std::size_t r = 0; r < corrections; ++r) {
-        correction_.push_back(multiply(unit[r], force_part));
-        correction_columns_.push_back(transpose(correction_.back()));
-      }
-      phi_ = multiply(unit[corrections], force_part);
-      phi_columns_ = transpose(phi_);
-      slope_ = multiply(unit[corrections + 1], force_part);
-      slope_columns_ = transpose(slope_);
-      // I - K2 W^T Φ_x.
-      const SparseMatrix minus_spring_rows = -SparseMatrix(spring_rows_);
-      const BandedMatrix lcp =
-          add_diagonal(multiply(minus_spring_rows, select_rows(phi_, 0, 2)), Vector::Ones(m_));
+      correction_ = std::move(ops.correction);
+      correction_columns_ = std::move(ops.correction_columns);
+      phi_ = std::move(ops.phi);
+      phi_columns_ = std::move(ops.phi_columns);
+      slope_ = std::move(ops.slope);
+      slope_columns_ = std::move(ops.slope_columns);
       std::string why;
-      if (!is_p_matrix(lcp, &why)) {
+      if (!is_p_matrix(ops.lcp, &why)) {
         throw InputError(fmt::format("pim.step = {}: the step's LCP matrix is not a P-matrix "
                                      "({}); use a smaller step",
                                      eta_, why));
       }
-      solver_.set_matrix(lcp);
-      lcp_ = lcp;
+      solver_.set_matrix(ops.lcp);
+      lcp_ = std::move(ops.lcp);
       lcp_lower_ = lcp_.lower_bandwidth();
       lcp_upper_ = lcp_.upper_bandwidth();
     }

@@ -143,6 +143,7 @@ struct SwitchingPimDiagnostics {
   long lcp_mismatches = 0;   // switching steps found by the LCP rather than the screen
   long gap_samples = 0;      // evaluations of the gap polynomials by the root search
   double step_argument = 0;  // η ω_max
+  bool from_period = false;  // operators laid out from a short chain (banded stepper)
 };
 
 class SwitchingPim : public Integrator {

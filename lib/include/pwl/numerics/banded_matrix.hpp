@@ -28,6 +28,8 @@
 
 namespace pwl {
 
+struct AxisRepeat;
+
 class BandedMatrix {
  public:
   BandedMatrix() = default;
@@ -106,6 +108,8 @@ class BandedMatrix {
 
  private:
   friend class BandedMatrixBuilder;
+  friend BandedMatrix repeat_period(const BandedMatrix& A, const AxisRepeat& rows,
+                                    const AxisRepeat& cols);
   void find_segments();
   double max_abs_rows(const double* x, double* y, Index row_begin, Index row_end) const;
   Index rows_ = 0;
@@ -169,5 +173,20 @@ BandedMatrix add_diagonal(const BandedMatrix& A, const Vector& diag);
 BandedMatrix select_rows(const BandedMatrix& A, Index first, Index stride);
 // A^T, banded: row j holds column j of A between the first and last rows whose runs reach it.
 BandedMatrix transpose(const BandedMatrix& A);
+
+// A periodic stretch along one axis of an operator: `before` rows (or columns) come before a
+// cut, `period` rows make one period of the structure, and `copies` periods are inserted at the
+// cut (construction from the period, lib/src/banded/periodic_cut.hpp).
+struct AxisRepeat {
+  Index before = 0;
+  Index period = 0;
+  Index copies = 0;
+  Index inserted() const { return period * copies; }
+};
+// A with `rows.copies` periods of rows inserted at the cut: row before + k·period + φ (k <
+// copies) is row before - period + φ of A moved (k + 1)·cols.period columns on, and the rows
+// after the cut are A's moved cols.inserted() columns on. The stored rows are A's, shared (no
+// row is computed or compared), so this costs one pass over the rows.
+BandedMatrix repeat_period(const BandedMatrix& A, const AxisRepeat& rows, const AxisRepeat& cols);
 
 }  // namespace pwl
