@@ -2,17 +2,15 @@
 // 39(7) (2018) 737-749 (eqs 8-14 and 20-22), built from the banded exponential.
 #include "pwl/integrators/banded_step_operators.hpp"
 
+#include <algorithm>
+#include <numeric>
 #include <optional>
 #include <string>
 
+#include "banded/ordered_springs.hpp"
 #include "banded/periodic_cut.hpp"
 #include "pwl/errors.hpp"
 #include "pwl/numerics/substructure_exponential.hpp"
-
-#include <algorithm>
-#include <numeric>
-
-#include "pwl/errors.hpp"
 
 namespace pwl {
 
@@ -38,30 +36,13 @@ namespace {
 // The springs in spring_order: their gaps and stiffnesses, K2 W^T, and G_v = -M⁻¹W (the velocity
 // rows of G), returned.
 SparseMatrix set_springs(const GapStructure& structure, BandedStepOperators& ops) {
-  const Index n = structure.dofs();
-  const Index m = structure.spring_count();
-  ops.spring_order = springs_by_position(structure);
-  ops.gaps.resize(m);
-  ops.stiffnesses.resize(m);
-  std::vector<Eigen::Triplet<double>> g, k2wt;
-  const Vector mass = structure.mass.diagonal();
-  for (Index j = 0; j < m; ++j) {
-    const GapSpring& s = structure.springs[static_cast<std::size_t>(
-        ops.spring_order[static_cast<std::size_t>(j)])];
-    ops.gaps[j] = s.gap;
-    ops.stiffnesses[j] = s.stiffness;
-    const auto add = [&](Index dof, double direction) {
-      g.emplace_back(dof, j, -direction / mass[dof]);
-      k2wt.emplace_back(j, dof, s.stiffness * direction);
-    };
-    add(s.dof, s.direction);
-    if (s.other_dof >= 0) add(s.other_dof, -s.direction);
-  }
-  SparseMatrix G(n, m);
-  G.setFromTriplets(g.begin(), g.end());
-  ops.gap_rows.resize(m, n);
-  ops.gap_rows.setFromTriplets(k2wt.begin(), k2wt.end());
-  return G;
+  banded_detail::OrderedSprings springs = banded_detail::ordered_springs(structure);
+  ops.spring_order = std::move(springs.order);
+  ops.gaps = std::move(springs.gaps);
+  ops.stiffnesses = std::move(springs.stiffnesses);
+  ops.gap_rows = banded_detail::scaled_rows(SparseMatrix(springs.directions.transpose()),
+                                            ops.stiffnesses);
+  return banded_detail::scaled_rows(springs.directions, -structure.mass.diagonal().cwiseInverse());
 }
 
 // Every row from its substructure.
@@ -79,7 +60,8 @@ BandedStepOperators build_row_by_row(const GapStructure& structure, double step,
   // I - K2 W^T Φ_x, with Φ_x the displacement (even) rows of Φ.
   const BandedMatrix phi_x = select_rows(ops.force_next, 0, 2);
   const SparseMatrix minus_gap_rows = -ops.gap_rows;
-  ops.lcp_matrix = add_diagonal(multiply(minus_gap_rows, phi_x), Vector::Ones(structure.spring_count()));
+  ops.lcp_matrix =
+      add_diagonal(multiply(minus_gap_rows, phi_x), Vector::Ones(structure.spring_count()));
   return ops;
 }
 
@@ -97,23 +79,20 @@ BandedStepOperators make_banded_step_operators(const GapStructure& structure, do
   std::optional<BandedStepOperators> laid_out =
       banded_detail::build_from_period<BandedStepOperators>(
           structure, band,
-          [&](const GapStructure& short_chain) { return build_row_by_row(short_chain, step, band); },
+          [&](const GapStructure& short_chain) {
+            return build_row_by_row(short_chain, step, band);
+          },
           [&](const BandedStepOperators& built, const banded_detail::PeriodicCut& cut,
               const AxisRepeat& springs) {
-            const AxisRepeat state = banded_detail::axis_repeat(cut, 2 * cut.cut, 2 * cut.period);
+            const AxisRepeat state = banded_detail::state_axis(cut);
             BandedStepOperators ops;
             ops.step = step;
-            ops.truncation = built.truncation;
-            ops.truncation.blocks += cut.removed / built.truncation.cell_dofs;
-            ops.truncation.laid_out = cut.removed;
+            ops.truncation = banded_detail::laid_out_truncation(built.truncation, cut);
             set_springs(structure, ops);
             ops.transition = repeat_period(built.transition, state, state);
             ops.force_next = repeat_period(built.force_next, state, springs);
             ops.force_now = repeat_period(built.force_now, state, springs);
-            for (const HarmonicResponse& h : built.harmonics) {
-              ops.harmonics.push_back({h.omega, banded_detail::repeat_period(h.sin_response, state),
-                                       banded_detail::repeat_period(h.cos_response, state)});
-            }
+            ops.harmonics = banded_detail::repeat_period(built.harmonics, state);
             ops.lcp_matrix = repeat_period(built.lcp_matrix, springs, springs);
             return ops;
           });

@@ -5,10 +5,7 @@
 
 #include <algorithm>
 
-#include <fmt/format.h>
-
-#include "numerics/row_blocks.hpp"
-#include "pwl/errors.hpp"
+#include "pwl/integrators/banded_pim_integrator.hpp"
 #include "pwl/integrators/banded_step_operators.hpp"
 
 namespace pwl::banded_detail {
@@ -27,19 +24,24 @@ struct SpringsByDof {
     for (const GapSpring& g : s.springs) ++first[static_cast<std::size_t>(first_end(g) + 1)];
     for (std::size_t i = 1; i < first.size(); ++i) first[i] += first[i - 1];
   }
-  // Whether dof i carries the springs of dof i - p, seen from their first ends: the offsets of
-  // their ends (ground alike), directions, stiffnesses and gaps, in the same order.
+  // Whether dof i carries the springs of dof i - p as the banded operators see them, from their
+  // first ends: the offsets of their ends (ground alike), directions and stiffnesses, in the
+  // same order. (Not the gaps: no banded operator reads them.)
   bool repeats(const GapStructure& s, Index i, Index p) const {
     const auto at = [&](Index dof) { return first[static_cast<std::size_t>(dof)]; };
-    if (at(i + 1) - at(i) != at(i - p + 1) - at(i - p)) return false;
-    for (Index k = 0; k < at(i + 1) - at(i); ++k) {
-      const GapSpring& a = s.springs[static_cast<std::size_t>(order[static_cast<std::size_t>(at(i) + k)])];
-      const GapSpring& b =
-          s.springs[static_cast<std::size_t>(order[static_cast<std::size_t>(at(i - p) + k)])];
-      const bool same_other = (a.other_dof < 0 && b.other_dof < 0) ||
-                              (a.other_dof >= 0 && b.other_dof >= 0 && a.other_dof - i == b.other_dof - (i - p));
-      if (a.dof - i != b.dof - (i - p) || !same_other || a.direction != b.direction ||
-          a.stiffness != b.stiffness || a.gap != b.gap) {
+    const auto spring = [&](Index k) -> const GapSpring& {
+      return s.springs[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])];
+    };
+    const Index count = at(i + 1) - at(i);
+    if (count != at(i - p + 1) - at(i - p)) return false;
+    for (Index k = 0; k < count; ++k) {
+      const GapSpring& a = spring(at(i) + k);
+      const GapSpring& b = spring(at(i - p) + k);
+      const bool same_other =
+          (a.other_dof < 0 && b.other_dof < 0) ||
+          (a.other_dof >= 0 && b.other_dof >= 0 && a.other_dof - b.other_dof == p);
+      if (a.dof - b.dof != p || !same_other || a.direction != b.direction ||
+          a.stiffness != b.stiffness) {
         return false;
       }
     }
@@ -47,68 +49,56 @@ struct SpringsByDof {
   }
 };
 
-// The widest coupling: |i - j| over the non-zeros of M, C, K and the spring ends.
-Index coupling_span(const GapStructure& s) {
-  Index span = 0;
-  for (const SparseMatrix* A : {&s.mass, &s.damping, &s.stiffness}) {
-    for (Index j = 0; j < A->outerSize(); ++j) {
-      for (SparseMatrix::InnerIterator it(*A, j); it; ++it) {
-        span = std::max(span, std::abs(it.row() - j));
-      }
-    }
-  }
-  for (const GapSpring& g : s.springs) {
-    if (g.other_dof >= 0) span = std::max<Index>(span, std::abs(g.dof - g.other_dof));
-  }
-  return span;
-}
-
 }  // namespace
 
-std::optional<PeriodicCut> find_periodic_cut(const GapStructure& s, Index period, Index margin) {
+std::optional<PeriodicCut> find_periodic_cut(const GapStructure& s, const CellRepeats& repeats,
+                                             Index margin) {
   const Index n = s.dofs();
-  if (period <= 0 || margin <= 0 || n < 8 * period) return std::nullopt;
-  const std::vector<LoadGroup> loads = s.load_groups();
+  const Index base = repeats.shift();
+  const BandedLayout layout = banded_layout(s);
+  if (base <= 0 || margin <= 0 || !layout.diagonal_mass) return std::nullopt;
+  const Index span = std::max(layout.dof_bandwidth, layout.spring_reach);
   const SpringsByDof springs(s);
-  // repeats(i): degree of freedom i carries what i - period carries.
-  const auto repeats = [&](Index i) {
-    if (i < period) return false;
-    for (const SparseMatrix* A : {&s.mass, &s.damping, &s.stiffness}) {
-      if (!shifted_column_matches(*A, i - period, period)) return false;
-    }
-    for (const LoadGroup& g : loads) {
-      if (g.sin_part[i] != g.sin_part[i - period] || g.cos_part[i] != g.cos_part[i - period]) {
-        return false;
-      }
-    }
-    return springs.repeats(s, i, period);
-  };
   const Index mid = n / 2;
-  if (!repeats(mid)) return std::nullopt;
+  // M, C, K and the loads repeat with `base` over [run_first - base, run_last); within it they
+  // repeat with any multiple of base, which the gap springs may need.
+  if (!repeats.dof_repeats(mid)) return std::nullopt;
   Index run_first = mid, run_last = mid + 1;
-  while (run_first - 1 >= period && repeats(run_first - 1)) --run_first;
-  while (run_last < n && repeats(run_last)) ++run_last;
-  PeriodicCut cut;
-  cut.period = period;
-  cut.margin = margin;
-  cut.periodic_first = run_first - period;  // [a, b) repeats with the period
-  cut.periodic_last = run_last;
-  cut.cut = cut.periodic_first + margin;
-  const Index room = cut.periodic_last - margin - cut.cut;
-  cut.removed = room > 0 ? room / (2 * period) * (2 * period) : 0;
-  // Worth it only when a quarter of the chain goes, and the couplings across the cut must not
-  // reach over the whole removed stretch.
-  const Index span = coupling_span(s);
-  if (cut.removed < n / 4 || cut.removed <= span || margin <= span) return std::nullopt;
-  cut.span = span;
-  return cut;
+  while (run_first - 1 >= base && repeats.dof_repeats(run_first - 1)) --run_first;
+  while (run_last < n && repeats.dof_repeats(run_last)) ++run_last;
+  const Index a0 = run_first - base;
+  for (Index k = 1; k <= 8; ++k) {
+    const Index period = k * base;
+    const auto both = [&](Index i) {
+      return i - period >= a0 && i < run_last && springs.repeats(s, i, period);
+    };
+    if (!both(mid)) continue;
+    Index first = mid, last = mid + 1;
+    while (both(first - 1)) --first;
+    while (both(last)) ++last;
+    PeriodicCut cut;
+    cut.period = period;
+    cut.margin = margin;
+    cut.span = span;
+    cut.periodic_first = first - period;  // [a, b) repeats with the period
+    cut.periodic_last = last;
+    cut.cut = cut.periodic_first + margin;
+    const Index room = cut.periodic_last - margin - cut.cut;
+    cut.removed = room > 0 ? room / (2 * period) * (2 * period) : 0;
+    // Worth it only when a quarter of the chain goes (else a longer period may repeat over a
+    // longer stretch: springs on every fifth cell); the couplings across the cut must not reach
+    // over the whole removed stretch, nor the kept margin.
+    if (margin <= span) return std::nullopt;
+    if (cut.removed >= n / 4 && cut.removed > span) return cut;
+  }
+  return std::nullopt;
 }
 
 GapStructure shorten(const GapStructure& s, const PeriodicCut& cut) {
   const Index c = cut.cut, D = cut.removed, n = s.dofs();
   // Where degree of freedom pair (i, j) of the long chain goes in the short one: kept before the
   // cut, moved D back after it, and a pair from the removed stretch to beyond it stands in for
-  // the pair across the cut (the same content, one whole number of periods on). -1: left out.
+  // the pair across the cut (the same content, one whole number of periods on); false: left out.
   const auto place = [&](Index i, Index j, Index& si, Index& sj) {
     const Index lo = std::min(i, j), hi = std::max(i, j);
     if (hi < c) {
@@ -171,8 +161,8 @@ bool reach_fits(const PeriodicCut& cut, Index short_dofs, Index reach) {
          long_mid + reach <= cut.periodic_last;
 }
 
-AxisRepeat axis_repeat(const PeriodicCut& cut, Index units_before, Index units_per_period) {
-  return {units_before, units_per_period, cut.removed / cut.period};
+AxisRepeat state_axis(const PeriodicCut& cut) {
+  return {2 * cut.cut, 2 * cut.period, cut.removed / cut.period};
 }
 
 AxisRepeat spring_axis(const GapStructure& short_structure, const PeriodicCut& cut) {
@@ -182,16 +172,7 @@ AxisRepeat spring_axis(const GapStructure& short_structure, const PeriodicCut& c
     if (p < cut.cut) ++before;
     if (p < cut.cut && p >= cut.cut - cut.period) ++period;
   }
-  return axis_repeat(cut, before, period);
-}
-
-bool diagonal_mass(const GapStructure& s) {
-  for (Index j = 0; j < s.mass.outerSize(); ++j) {
-    for (SparseMatrix::InnerIterator it(s.mass, j); it; ++it) {
-      if (it.row() != j && it.value() != 0.0) return false;
-    }
-  }
-  return true;
+  return {before, period, cut.removed / cut.period};
 }
 
 Vector repeat_period(const Vector& v, const AxisRepeat& axis) {
@@ -203,6 +184,25 @@ Vector repeat_period(const Vector& v, const AxisRepeat& axis) {
   }
   out.tail(v.size() - axis.before) = v.tail(v.size() - axis.before);
   return out;
+}
+
+std::vector<HarmonicResponse> repeat_period(const std::vector<HarmonicResponse>& harmonics,
+                                            const AxisRepeat& state) {
+  std::vector<HarmonicResponse> out;
+  out.reserve(harmonics.size());
+  for (const HarmonicResponse& h : harmonics) {
+    out.push_back(
+        {h.omega, repeat_period(h.sin_response, state), repeat_period(h.cos_response, state)});
+  }
+  return out;
+}
+
+BandTruncation laid_out_truncation(const BandTruncation& built, const PeriodicCut& cut) {
+  BandTruncation t = built;
+  // One row block (a cell) per cell of the removed stretch.
+  if (t.cell_dofs > 0) t.blocks += cut.removed / t.cell_dofs;
+  t.laid_out = cut.removed;
+  return t;
 }
 
 }  // namespace pwl::banded_detail

@@ -281,9 +281,12 @@ Assembly assemble(const GapStructure& s, double step, const std::vector<LoadGrou
       out.largest = std::max(out.largest, block.window_last - block.window_first);
     }
     std::exception_ptr error;
-    // A parallel region only when there is work to share: waking a second thread per chunk costs
-    // more than a whole periodic chunk takes.
-#pragma omp parallel for schedule(dynamic) if (missing.size() > 1)
+    // Always inside a parallel region, even for one substructure: Eigen then keeps each
+    // exponential's products on one thread. Outside one it would split a large window's products
+    // over the threads, whose partial sums round differently, and a substructure's bits would
+    // depend on which other blocks share its chunk (construction from the period relies on them
+    // not depending on that).
+#pragma omp parallel for schedule(dynamic)
     for (std::size_t k = 0; k < missing.size(); ++k) {
       try {
         const RowBlock& block = *missing[k].second;
@@ -306,14 +309,17 @@ Assembly assemble(const GapStructure& s, double step, const std::vector<LoadGrou
   return out;
 }
 
-// A first margin from the substructure around the middle row alone (grown until its band fits).
-Index probe_margin(const GapStructure& s, double step, const BandedExponentialOptions& o) {
+// A first margin from the substructure around the middle row alone (grown until its band fits);
+// *reach: how far from the middle row the largest substructure probed reached.
+Index probe_margin(const GapStructure& s, double step, const BandedExponentialOptions& o,
+                   Index* reach) {
   const Index n = s.dofs();
   const Index mid = n / 2;
   for (Index R = std::max<Index>(4, o.guard + 3);; R *= 2) {
     const Index first = std::max<Index>(0, mid - R), last = std::min(n, mid + R + 1);
     // T alone: the load integrals fall off faster, and the assembly checks them anyway.
     const Index w = last - first, li = mid - first;
+    *reach = R;
     const Matrix T = precise_exponential(substructure_state_matrix(s, first, last), step,
                                          o.exponential);
     Profiles p(4, R);
@@ -376,8 +382,9 @@ BandedExponential make_banded_exponential(const GapStructure& structure, double 
   const std::vector<LoadGroup> groups = structure.load_groups();
   const Index cell = options.cell_dofs > 0 ? options.cell_dofs : detect_cell_size(structure);
 
+  Index probed = 0;
   Index margin = options.band > 0 ? options.band + options.guard
-                                  : probe_margin(structure, step, options);
+                                  : probe_margin(structure, step, options, &probed);
   Assembly a;
   Index q = options.band;
   int assemblies = 0;
@@ -419,6 +426,7 @@ BandedExponential make_banded_exponential(const GapStructure& structure, double 
   t.exponentials = a.exponentials;
   t.largest_substructure = a.largest;
   t.assemblies = assemblies;
+  t.probe_reach = probed;
   return out;
 }
 

@@ -37,6 +37,11 @@ class CellRepeats {
  public:
   CellRepeats(const GapStructure& structure, Index cell, const std::vector<LoadGroup>& loads);
   Index shift() const { return shift_; }
+  // True when degree of freedom i carries what i - shift() carries (M, C, K and loads).
+  bool dof_repeats(Index i) const {
+    return shift_ > 0 && i >= shift_ &&
+           differing_[static_cast<std::size_t>(i + 1)] == differing_[static_cast<std::size_t>(i)];
+  }
   // True when window [first, last) holds exactly the content of [first - shift, last - shift).
   bool repeats_earlier(Index first, Index last) const {
     return shift_ > 0 && first >= shift_ &&

@@ -23,6 +23,7 @@
 #include "pwl/numerics/substructure_exponential.hpp"
 #include "pwl/numerics/state_checks.hpp"
 #include "numerics/row_blocks.hpp"
+#include "banded/ordered_springs.hpp"
 #include "banded/periodic_cut.hpp"
 #include "switching/local_switch_correction.hpp"
 #include "switching/switching_pim_detail.hpp"
@@ -123,42 +124,9 @@ std::vector<BandedMatrix> banded_force_coefficients(const GapStructure& s, doubl
   return out;
 }
 
-// W with its columns in springs_by_position order, and the springs' gaps and stiffnesses in that
-// order.
-struct SortedSprings {
-  SparseMatrix directions;
-  Vector gaps, stiffnesses;
-};
-
-SortedSprings sorted_springs(const GapStructure& s) {
-  const Index m = s.spring_count();
-  const std::vector<Index> order = springs_by_position(s);
-  SortedSprings out{SparseMatrix(s.dofs(), m), Vector(m), Vector(m)};
-  std::vector<Eigen::Triplet<double>> w;
-  for (Index j = 0; j < m; ++j) {
-    const GapSpring& g = s.springs[static_cast<std::size_t>(order[static_cast<std::size_t>(j)])];
-    out.gaps[j] = g.gap;
-    out.stiffnesses[j] = g.stiffness;
-    w.emplace_back(g.dof, j, g.direction);
-    if (g.other_dof >= 0) w.emplace_back(g.other_dof, j, -g.direction);
-  }
-  out.directions.setFromTriplets(w.begin(), w.end());
-  return out;
-}
-
-// diag(scale) A, in O(non-zeros) (Eigen's diagonal-times-sparse assignment inserts entry by
-// entry).
-SparseMatrix scaled_rows(const SparseMatrix& A, const Vector& scale) {
-  SparseMatrix B = A;
-  for (Index j = 0; j < B.outerSize(); ++j) {
-    for (SparseMatrix::InnerIterator it(B, j); it; ++it) it.valueRef() *= scale[it.row()];
-  }
-  return B;
-}
-
 // -M⁻¹ W, the accelerations of unit spring forces (a diagonal mass).
 SparseMatrix spring_accelerations(const GapStructure& s, const SparseMatrix& W) {
-  return scaled_rows(W, -s.mass.diagonal().cwiseInverse());
+  return banded_detail::scaled_rows(W, -s.mass.diagonal().cwiseInverse());
 }
 
 // The step's banded operators of one structure (the members of BandedStepper below).
@@ -181,7 +149,7 @@ StepOperatorSet build_step_operators(const GapStructure& s, double eta, int d, b
   out.transition = std::move(e.transition);
   out.harmonics = std::move(e.harmonics);
   if (s.spring_count() == 0) return out;
-  const SortedSprings springs = sorted_springs(s);
+  const banded_detail::OrderedSprings springs = banded_detail::ordered_springs(s);
   const SparseMatrix force_part = spring_accelerations(s, springs.directions);
   const std::vector<BandedMatrix> unit =
       banded_force_coefficients(s, eta, d, end, out.truncation.band, out.truncation.margin,
@@ -196,7 +164,7 @@ StepOperatorSet build_step_operators(const GapStructure& s, double eta, int d, b
   out.slope = multiply(unit[corrections + 1], force_part);
   out.slope_columns = transpose(out.slope);
   const SparseMatrix minus_spring_rows =
-      scaled_rows(SparseMatrix(springs.directions.transpose()), -springs.stiffnesses);
+      banded_detail::scaled_rows(SparseMatrix(springs.directions.transpose()), -springs.stiffnesses);
   out.lcp = add_diagonal(multiply(minus_spring_rows, select_rows(out.phi, 0, 2)),
                          Vector::Ones(s.spring_count()));
   return out;
@@ -205,22 +173,16 @@ StepOperatorSet build_step_operators(const GapStructure& s, double eta, int d, b
 // The operators of a long chain from those of the short chain of `cut` (periodic_cut.hpp).
 StepOperatorSet repeat_period(const StepOperatorSet& o, const banded_detail::PeriodicCut& cut,
                               const AxisRepeat& springs) {
-  const AxisRepeat state = banded_detail::axis_repeat(cut, 2 * cut.cut, 2 * cut.period);
+  const AxisRepeat state = banded_detail::state_axis(cut);
   StepOperatorSet out;
-  out.truncation = o.truncation;
-  // One row block (a cell) per inserted cell.
-  if (o.truncation.cell_dofs > 0) out.truncation.blocks += cut.removed / o.truncation.cell_dofs;
-  out.truncation.laid_out = cut.removed;
+  out.truncation = banded_detail::laid_out_truncation(o.truncation, cut);
   out.transition = repeat_period(o.transition, state, state);
-  for (const HarmonicResponse& h : o.harmonics) {
-    out.harmonics.push_back({h.omega, banded_detail::repeat_period(h.sin_response, state),
-                             banded_detail::repeat_period(h.cos_response, state)});
-  }
+  out.harmonics = banded_detail::repeat_period(o.harmonics, state);
+  if (o.lcp.rows() == 0) return out;  // no springs
   for (std::size_t r = 0; r < o.correction.size(); ++r) {
     out.correction.push_back(repeat_period(o.correction[r], state, springs));
     out.correction_columns.push_back(repeat_period(o.correction_columns[r], springs, state));
   }
-  if (o.lcp.rows() == 0) return out;
   out.phi = repeat_period(o.phi, state, springs);
   out.phi_columns = repeat_period(o.phi_columns, springs, state);
   out.slope = repeat_period(o.slope, state, springs);
@@ -251,12 +213,12 @@ class BandedStepper final : public SwitchingPim,
         correction_mode_(options.switch_correction), solver_(options.lcp) {
     // Sparse parts of the equation of motion, springs by position along the structure.
     const Vector inverse_mass = s.mass.diagonal().cwiseInverse();
-    SortedSprings springs = sorted_springs(s);
+    banded_detail::OrderedSprings springs = banded_detail::ordered_springs(s);
     const SparseMatrix& W = springs.directions;
     gaps_ = std::move(springs.gaps);
     stiffnesses_ = std::move(springs.stiffnesses);
-    stiffness_part_ = RowSparse(scaled_rows(s.stiffness, -inverse_mass));
-    damping_part_ = RowSparse(scaled_rows(s.damping, -inverse_mass));
+    stiffness_part_ = RowSparse(banded_detail::scaled_rows(s.stiffness, -inverse_mass));
+    damping_part_ = RowSparse(banded_detail::scaled_rows(s.damping, -inverse_mass));
     const SparseMatrix force_part = spring_accelerations(s, W);
     force_part_ = RowSparse(force_part);
     gap_rows_ = RowSparse(SparseMatrix(W.transpose()));
@@ -344,7 +306,7 @@ class BandedStepper final : public SwitchingPim,
     }
 
     const int terms = std::max(o_.max_series_terms, d_ + 2) + 1;
-    size_series(static_cast<std::size_t>(terms), n_, m_);
+    size_series(static_cast<std::size_t>(terms), n_, m_, static_cast<std::size_t>(d_ + 4));
     size_local(m_);
     mode_ = Vector::Zero(m_);
     signs_ = Vector::Constant(m_, -1.0);

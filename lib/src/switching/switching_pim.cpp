@@ -273,7 +273,7 @@ class Stepper final
     }
     phases_ = Phases(0.0, 0.0, 1.0);
     const int terms = std::max(o.max_series_terms, d_ + 2) + 1;
-    size_series(static_cast<std::size_t>(terms), n_, m_);
+    size_series(static_cast<std::size_t>(terms), n_, m_, static_cast<std::size_t>(d_ + 4));
     mode_ = Force::Zero(m_);
     signs_ = Force::Constant(m_, -1.0);
     state_ = State::Zero(2 * n_);

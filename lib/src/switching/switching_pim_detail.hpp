@@ -365,12 +365,24 @@ class ModeSeries {
     return true;
   }
 
-  // Sizes the series buffers for `terms` terms, n degrees of freedom and m springs.
-  void size_series(std::size_t terms, Index n, Index m) {
-    xs_.assign(terms, Half::Zero(n));
-    us_.assign(terms, Half::Zero(n));
-    ps_.assign(terms, Force::Zero(m));
-    gw_.assign(terms, Force::Zero(m));
+  // Sizes the series buffers for `terms` terms, n degrees of freedom and m springs. The first
+  // `eager` terms (those every step reads: its force polynomial's degree and the screen's) are
+  // allocated now, the others when a series first reaches them (taylor()): a long series is
+  // only needed in the pieces of switching steps and rarely runs to the limit, and 41 terms of
+  // the whole state would be 1.3 GB at 10^6 masses, zeroed before the first step.
+  void size_series(std::size_t terms, Index n, Index m, std::size_t eager) {
+    series_n_ = n;
+    series_m_ = m;
+    allocated_terms_ = 0;
+    for (auto* v : {&xs_, &us_}) {
+      v->clear();
+      v->resize(terms);  // empty (or, for fixed sizes, not yet set): allocate_terms sets them
+    }
+    for (auto* v : {&ps_, &gw_}) {
+      v->clear();
+      v->resize(terms);
+    }
+    allocate_terms(std::min(eager, terms));
     vx_ = Half::Zero(n);
     vu_ = vx_;
     acc_ = vx_;
@@ -392,6 +404,7 @@ class ModeSeries {
   // t, h and start that stopped there, and the series continues from them.
   int taylor(double t, double h, int last, double tol, bool full = true, int first = 0) {
     Stepper& st = self();
+    allocate_terms(static_cast<std::size_t>(last) + 1);
     double largest = 0.0;
     if (first == 0) {
       st.gap_product(xs_[0], gw_[0]);
@@ -662,6 +675,17 @@ class ModeSeries {
 
   std::vector<Half> xs_, us_;
   std::vector<Force> ps_, gw_;
+  Index series_n_ = 0, series_m_ = 0;
+  std::size_t allocated_terms_ = 0;  // xs_, us_, ps_, gw_ [0, allocated_terms_) are sized
+  // Sizes (zeroed) the terms below `count` that are not yet.
+  void allocate_terms(std::size_t count) {
+    for (; allocated_terms_ < std::min(count, xs_.size()); ++allocated_terms_) {
+      xs_[allocated_terms_] = Half::Zero(series_n_);
+      us_[allocated_terms_] = Half::Zero(series_n_);
+      ps_[allocated_terms_] = Force::Zero(series_m_);
+      gw_[allocated_terms_] = Force::Zero(series_m_);
+    }
+  }
   Half vx_, vu_;  // the state a piece ends in
   Half acc_;      // scratch of taylor()
   // advance_with_tangent: the tangent (2n x p, rows [x; x']) the pieces also map, null otherwise;

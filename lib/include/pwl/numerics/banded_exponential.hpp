@@ -61,12 +61,12 @@ struct BandedExponentialOptions {
   bool share_rows = true;    // store identical rows once (BandedMatrix)
   // Construction from the period, for the steppers' operator sets (make_banded_step_operators,
   // make_banded_switching_pim; make_banded_exponential alone always builds row by row): where
-  // the middle of a chain repeats (masses, dampers, springs, gap springs and loads), the operators
-  // are computed for a short chain with the same ends, its middle cut down to the reach of a row,
-  // and the long chain's rows laid out from it. The rows are bit for bit those of the row-by-row
-  // build, and the construction no longer grows with the chain's length except for one pass over
-  // its rows (lib/src/banded/periodic_cut.hpp). Needs share_rows. false: every row built from
-  // its substructure.
+  // the middle of a chain repeats (masses, dampers, springs, the gap springs' directions and
+  // stiffnesses, loads), the operators are computed for a short chain with the same ends, its
+  // middle cut down to the reach of a row, and the long chain's rows laid out from it. Their
+  // entries are bit for bit those of the row-by-row build, and the construction no longer grows
+  // with the chain's length except for one pass over its rows (lib/src/banded/periodic_cut.hpp).
+  // Needs share_rows. false: every row built from its substructure.
   bool from_period = true;
   // N and the Taylor order of every substructure. The doublings are trimmed to those the
   // substructure needs (precise_exponential.hpp), and a series of order 8 needs fewer of them:
@@ -90,6 +90,7 @@ struct BandTruncation {
   Index exponentials = 0;      // substructure exponentials actually computed (distinct content)
   Index largest_substructure = 0;  // dofs
   int assemblies = 0;          // more than 1 when the band outgrew the first margin
+  Index probe_reach = 0;       // dofs around the middle row read to probe the first margin
   Index laid_out = 0;          // dofs whose rows were laid out from the period, not built
   bool within_tolerance() const { return dropped_ratio <= tolerance; }
 };
