@@ -9,23 +9,12 @@
 #include <omp.h>
 
 #include <catch2/catch.hpp>
-#include <cstring>
 
 #include "pwl/integrators/banded_step_operators.hpp"
 #include "pwl/model/chain_builders.hpp"
+#include "step_operator_bits.hpp"
 
 using namespace pwl;
-
-namespace {
-
-bool same_bits(const BandedMatrix& a, const BandedMatrix& b) {
-  if (a.rows() != b.rows() || a.cols() != b.cols()) return false;
-  const Matrix da = a.to_dense(), db = b.to_dense();
-  return std::memcmp(da.data(), db.data(), sizeof(double) * static_cast<std::size_t>(da.size())) ==
-         0;
-}
-
-}  // namespace
 
 TEST_CASE("construction from the period: wide substructures on two threads, bit for bit",
           "[banded][period][threads]") {
@@ -52,13 +41,5 @@ TEST_CASE("construction from the period: wide substructures on two threads, bit 
   CHECK(a.truncation.cell_dofs == 4);
   CHECK(a.truncation.margin > 75);  // substructures of more than 150 masses
   CHECK(a.truncation.laid_out >= n / 4);
-  CHECK(same_bits(a.transition, b.transition));
-  CHECK(same_bits(a.force_now, b.force_now));
-  CHECK(same_bits(a.force_next, b.force_next));
-  CHECK(same_bits(a.lcp_matrix, b.lcp_matrix));
-  REQUIRE(a.harmonics.size() == b.harmonics.size());
-  for (std::size_t g = 0; g < a.harmonics.size(); ++g) {
-    const Vector d = a.harmonics[g].sin_response - b.harmonics[g].sin_response;
-    CHECK(d.cwiseAbs().maxCoeff() == 0.0);
-  }
+  pwl::test::check_same_step_operators(a, b);
 }
