@@ -2,7 +2,7 @@
 // periodic_cut.hpp): a chain whose middle repeats gets its step operators from a short chain with
 // the same ends. Truth: the same operators or stepper with every row built from its own
 // substructure (from_period = false). The rows are claimed to be bit for bit the same, so the
-// motion over a thousand steps with switches must be too (a few hundred where the clearances
+// motion over a thousand steps with switches must be too (a hundred where the clearances
 // between neighbours switch tens of times a step); chains that do not repeat in the middle, or are
 // too short to gain, must be built row by row.
 #include <catch2/catch.hpp>
@@ -131,7 +131,7 @@ TEST_CASE("construction from the period: defects near both ends and springs betw
   CHECK(p.from_period->diagnostics().from_period);
   Vector x0 = Vector::Zero(n);
   for (int i = 0; i < n; ++i) x0[i] = 0.3 * std::sin(0.05 * i);
-  const Run r = run(p, x0, eta, 200);
+  const Run r = run(p, x0, eta, 100);
   INFO("switches " << r.switches << ", largest |x| " << r.largest);
   CHECK(r.switches > 1000);
   CHECK(r.difference == 0.0);
@@ -141,8 +141,8 @@ TEST_CASE("construction from the period: defects near both ends and springs betw
   t1(n + n / 2, 1) = t2(n + n / 2, 1) = 1.0;
   p.from_period->set_state(0.0, x0, Vector::Zero(n));
   p.row_by_row->set_state(0.0, x0, Vector::Zero(n));
-  p.from_period->advance_with_tangent(3.0, t1);
-  p.row_by_row->advance_with_tangent(3.0, t2);
+  p.from_period->advance_with_tangent(1.5, t1);
+  p.row_by_row->advance_with_tangent(1.5, t2);
   CHECK((t1 - t2).cwiseAbs().maxCoeff() == 0.0);
   CHECK(t1.cwiseAbs().maxCoeff() > 0.0);
 }
@@ -154,7 +154,7 @@ TEST_CASE("construction from the period: cells of two masses, springs listed bac
   Pair p = both(two_mass_cells(n), eta);
   CHECK(p.from_period->diagnostics().from_period);
   const Vector x0 = Vector::LinSpaced(n, 0.2, -0.2);
-  const Run r = run(p, x0, eta, 200);
+  const Run r = run(p, x0, eta, 100);
   INFO("switches " << r.switches << ", largest |x| " << r.largest);
   CHECK(r.switches > 100);
   CHECK(r.difference == 0.0);
