@@ -5,11 +5,9 @@
 #include <algorithm>
 #include <numeric>
 #include <optional>
-#include <string>
 
 #include "banded/ordered_springs.hpp"
 #include "banded/periodic_cut.hpp"
-#include "pwl/errors.hpp"
 #include "pwl/numerics/substructure_exponential.hpp"
 
 namespace pwl {
@@ -42,7 +40,7 @@ SparseMatrix set_springs(const GapStructure& structure, BandedStepOperators& ops
   ops.stiffnesses = std::move(springs.stiffnesses);
   ops.gap_rows = banded_detail::scaled_rows(SparseMatrix(springs.directions.transpose()),
                                             ops.stiffnesses);
-  return banded_detail::scaled_rows(springs.directions, -structure.mass.diagonal().cwiseInverse());
+  return banded_detail::spring_accelerations(structure, springs.directions);
 }
 
 // Every row from its substructure.
@@ -69,9 +67,7 @@ BandedStepOperators build_row_by_row(const GapStructure& structure, double step,
 
 BandedStepOperators make_banded_step_operators(const GapStructure& structure, double step,
                                                const BandedExponentialOptions& options) {
-  std::string why;
-  if (!options.is_valid(&why)) throw InputError("banded exponential options: " + why);
-  structure.validate();
+  banded_detail::check_banded_inputs(structure, step, options);
   BandedExponentialOptions band = options;
   if (band.cell_dofs == 0) band.cell_dofs = detect_cell_size(structure);
   // Construction from the period (periodic_cut.hpp): the banded operators of a short chain laid

@@ -30,4 +30,8 @@ SparseMatrix scaled_rows(const SparseMatrix& A, const Vector& scale) {
   return B;
 }
 
+SparseMatrix spring_accelerations(const GapStructure& s, const SparseMatrix& W) {
+  return scaled_rows(W, -s.mass.diagonal().cwiseInverse());
+}
+
 }  // namespace pwl::banded_detail

@@ -15,6 +15,9 @@ struct OrderedSprings {
 };
 OrderedSprings ordered_springs(const GapStructure& structure);
 
+// -M⁻¹ W, the accelerations of unit spring forces (a diagonal mass).
+SparseMatrix spring_accelerations(const GapStructure& structure, const SparseMatrix& W);
+
 // diag(scale) A, in O(non-zeros) (Eigen's diagonal-times-sparse assignment inserts entry by
 // entry).
 SparseMatrix scaled_rows(const SparseMatrix& A, const Vector& scale);

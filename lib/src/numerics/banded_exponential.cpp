@@ -369,8 +369,10 @@ bool mass_is_diagonal(const SparseMatrix& M, std::string* why) {
 
 }  // namespace
 
-BandedExponential make_banded_exponential(const GapStructure& structure, double step,
-                                          const BandedExponentialOptions& options) {
+namespace banded_detail {
+
+void check_banded_inputs(const GapStructure& structure, double step,
+                         const BandedExponentialOptions& options) {
   std::string why;
   if (!options.is_valid(&why)) throw InputError("banded exponential options: " + why);
   structure.validate();
@@ -378,6 +380,13 @@ BandedExponential make_banded_exponential(const GapStructure& structure, double 
     throw InputError(fmt::format("step = {} must be positive and finite", step));
   }
   if (!mass_is_diagonal(structure.mass, &why)) throw InputError(why);
+}
+
+}  // namespace banded_detail
+
+BandedExponential make_banded_exponential(const GapStructure& structure, double step,
+                                          const BandedExponentialOptions& options) {
+  banded_detail::check_banded_inputs(structure, step, options);
   const Index n = structure.dofs();
   const std::vector<LoadGroup> groups = structure.load_groups();
   const Index cell = options.cell_dofs > 0 ? options.cell_dofs : detect_cell_size(structure);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "pwl/model/gap_structure.hpp"
+#include "pwl/numerics/banded_exponential.hpp"
 #include "pwl/types.hpp"
 
 namespace pwl::banded_detail {
@@ -19,6 +20,13 @@ struct RowBlock {
 // cell size p, the interior blocks are single cells, so that their substructures coincide in a
 // periodic structure; the rows near each end form one block whose substructure holds that end.
 std::vector<RowBlock> partition_rows(Index n, Index margin, Index cell);
+
+// The banded methods' input checks, before anything is built: the options, the structure, a
+// positive finite step and a diagonal mass (InputError naming the field otherwise). Shared by
+// make_banded_exponential and make_banded_step_operators, which checks them before it builds
+// from the period, so that an error names the long chain's fields.
+void check_banded_inputs(const GapStructure& structure, double step,
+                         const BandedExponentialOptions& options);
 
 // Whether column j + p of A is column j shifted down by p (rows and values).
 bool shifted_column_matches(const SparseMatrix& A, Index j, Index p);

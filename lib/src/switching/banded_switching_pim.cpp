@@ -124,11 +124,6 @@ std::vector<BandedMatrix> banded_force_coefficients(const GapStructure& s, doubl
   return out;
 }
 
-// -M⁻¹ W, the accelerations of unit spring forces (a diagonal mass).
-SparseMatrix spring_accelerations(const GapStructure& s, const SparseMatrix& W) {
-  return banded_detail::scaled_rows(W, -s.mass.diagonal().cwiseInverse());
-}
-
 // The step's banded operators of one structure (the members of BandedStepper below).
 struct StepOperatorSet {
   BandTruncation truncation;
@@ -150,7 +145,7 @@ StepOperatorSet build_step_operators(const GapStructure& s, double eta, int d, b
   out.harmonics = std::move(e.harmonics);
   if (s.spring_count() == 0) return out;
   const banded_detail::OrderedSprings springs = banded_detail::ordered_springs(s);
-  const SparseMatrix force_part = spring_accelerations(s, springs.directions);
+  const SparseMatrix force_part = banded_detail::spring_accelerations(s, springs.directions);
   const std::vector<BandedMatrix> unit =
       banded_force_coefficients(s, eta, d, end, out.truncation.band, out.truncation.margin,
                                 out.truncation.cell_dofs, band);
@@ -219,7 +214,7 @@ class BandedStepper final : public SwitchingPim,
     stiffnesses_ = std::move(springs.stiffnesses);
     stiffness_part_ = RowSparse(banded_detail::scaled_rows(s.stiffness, -inverse_mass));
     damping_part_ = RowSparse(banded_detail::scaled_rows(s.damping, -inverse_mass));
-    const SparseMatrix force_part = spring_accelerations(s, W);
+    const SparseMatrix force_part = banded_detail::spring_accelerations(s, W);
     force_part_ = RowSparse(force_part);
     gap_rows_ = RowSparse(SparseMatrix(W.transpose()));
     spring_rows_ = RowSparse(stiffnesses_.asDiagonal() * gap_rows_);
