@@ -197,11 +197,7 @@ class LocalSwitchCorrection {
     local_rows_ = 0;
     terms_u_ = R;
     base_mode_ = st.mode_;
-    scale_ = 0.0;
-    for (int r = 0; r <= R; ++r) {
-      scale_ = std::max({scale_, st.xs_[static_cast<std::size_t>(r)].cwiseAbs().maxCoeff(),
-                         st.us_[static_cast<std::size_t>(r)].cwiseAbs().maxCoeff()});
-    }
+    scale_ = st.series_largest_;  // the largest entry of the terms 0 .. R
     // The step's record, for its tangent now (advance_with_tangent) or for a replay later.
     const bool keep = st.tangent_ != nullptr || st.noting();
     LocalStep record;

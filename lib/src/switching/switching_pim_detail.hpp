@@ -30,6 +30,15 @@ class PolynomialGaps final : public event_detail::ModeGaps {
     const Index m = c.rows();
     const Index R = c.cols() - 1;
     out.t = s;
+    if (s == 0.0) {
+      // Horner's rule below gives c_0, c_1 and 2 c_2 at σ = 0, exactly for finite coefficients
+      // (a series that is not finite fails the step's divergence check either way). Every piece
+      // starts here, over all springs, so it is a copy.
+      out.e = c.col(0);
+      if (R >= 1) out.rate = c.col(1); else out.rate.setZero(m);
+      if (R >= 2) out.accel = 2.0 * c.col(2); else out.accel.setZero(m);
+      return;
+    }
     out.e.resize(m);
     out.rate.resize(m);
     out.accel.resize(m);
@@ -127,15 +136,18 @@ struct CandidateSprings {
   PolynomialGaps poly;
   event_detail::SearchSettings settings;
   event_detail::GapSample start;
+  Vector rest_;  // scratch of select()
 
   void select(const PolynomialGaps& all, const event_detail::SearchSettings& all_settings) {
     const Matrix& c = all.c;
     const Index m = c.rows(), R = c.cols() - 1;
     springs.clear();
     row_of.assign(static_cast<std::size_t>(m), -1);
+    // S_j = Σ_{r>=2} |c(j, r)| column by column (contiguous; the same sums in the same order).
+    rest_.setZero(m);
+    for (Index r = 2; r <= R; ++r) rest_ += c.col(r).cwiseAbs();
     for (Index j = 0; j < m; ++j) {
-      double rest = 0.0;
-      for (Index r = 2; r <= R; ++r) rest += std::abs(c(j, r));
+      const double rest = rest_[j];
       const double c1 = R >= 1 ? c(j, 1) : 0.0;
       // Horner's rounding on [0, 1] is below about 2R ε Σ|c_r|.
       const double margin =
@@ -414,12 +426,15 @@ class ModeSeries {
         load_scale_[g] = 1.0;
       }
     }
-    for (int r = 0; r < first; ++r) {
-      largest = std::max({largest, xs_[static_cast<std::size_t>(r)].cwiseAbs().maxCoeff(),
-                          us_[static_cast<std::size_t>(r)].cwiseAbs().maxCoeff()});
+    // The largest entry of the terms so far (the convergence test's scale): only with tol > 0.
+    double u_size = 0.0;  // the largest entry of us_[r] for the r at hand (with tol > 0)
+    if (tol > 0.0) {
+      for (int r = 0; r <= first; ++r) {
+        u_size = us_[static_cast<std::size_t>(r)].cwiseAbs().maxCoeff();
+        largest = std::max({largest, xs_[static_cast<std::size_t>(r)].cwiseAbs().maxCoeff(), u_size});
+      }
     }
-    largest = std::max({largest, xs_[static_cast<std::size_t>(first)].cwiseAbs().maxCoeff(),
-                        first == 0 ? us_[0].cwiseAbs().maxCoeff() : 0.0});
+    series_largest_ = largest;
     double previous = largest;
     for (int r = first; r < last; ++r) {
       const auto ru = static_cast<std::size_t>(r);
@@ -446,9 +461,12 @@ class ModeSeries {
       }
       us_[ru + 1] = f * acc_;
       if (tol > 0.0) {
-        const double size =
-            std::max(xs_[ru + 1].cwiseAbs().maxCoeff(), us_[ru + 1].cwiseAbs().maxCoeff());
+        // max |f u_i| = f max |u_i| exactly: rounding is monotone and symmetric.
+        const double x_size = f * u_size;
+        u_size = us_[ru + 1].cwiseAbs().maxCoeff();
+        const double size = std::max(x_size, u_size);
         largest = std::max(largest, size);
+        series_largest_ = largest;
         if (r + 1 >= 4 && size + previous <= tol * largest) return r + 1;
         previous = size;
       }
@@ -686,6 +704,8 @@ class ModeSeries {
       gw_[allocated_terms_] = Force::Zero(series_m_);
     }
   }
+  // With tol > 0, the largest entry of the terms 0 .. R of taylor()'s last series.
+  double series_largest_ = 0.0;
   Half vx_, vu_;  // the state a piece ends in
   Half acc_;      // scratch of taylor()
   // advance_with_tangent: the tangent (2n x p, rows [x; x']) the pieces also map, null otherwise;
