@@ -35,8 +35,16 @@ class PolynomialGaps final : public event_detail::ModeGaps {
       // (a series that is not finite fails the step's divergence check either way). Every piece
       // starts here, over all springs, so it is a copy.
       out.e = c.col(0);
-      if (R >= 1) out.rate = c.col(1); else out.rate.setZero(m);
-      if (R >= 2) out.accel = 2.0 * c.col(2); else out.accel.setZero(m);
+      if (R >= 1) {
+        out.rate = c.col(1);
+      } else {
+        out.rate.setZero(m);
+      }
+      if (R >= 2) {
+        out.accel = 2.0 * c.col(2);
+      } else {
+        out.accel.setZero(m);
+      }
       return;
     }
     out.e.resize(m);
@@ -430,8 +438,9 @@ class ModeSeries {
     double u_size = 0.0;  // the largest entry of us_[r] for the r at hand (with tol > 0)
     if (tol > 0.0) {
       for (int r = 0; r <= first; ++r) {
-        u_size = us_[static_cast<std::size_t>(r)].cwiseAbs().maxCoeff();
-        largest = std::max({largest, xs_[static_cast<std::size_t>(r)].cwiseAbs().maxCoeff(), u_size});
+        const auto ru = static_cast<std::size_t>(r);
+        u_size = us_[ru].cwiseAbs().maxCoeff();
+        largest = std::max({largest, xs_[ru].cwiseAbs().maxCoeff(), u_size});
       }
     }
     series_largest_ = largest;
