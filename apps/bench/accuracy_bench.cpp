@@ -388,19 +388,22 @@ void large_chain(const AccuracyOptions& o) {
     }
     curves.push_back(std::move(c));
   }
-  {
-    // The switching PIM with banded operators (banded_switching_pim.hpp), default d = 2 with the
-    // end slope, from η = 0.5 s (its cost is then that of locating the run's switches, the same
-    // at any step) until it reaches the truth's tolerance.
+  for (int degree : {2, 4}) {
+    // The switching PIM with banded operators (banded_switching_pim.hpp), d = 2 (the default) and
+    // 4 with the end slope, from η = 0.5 s (its cost is then that of locating the run's switches,
+    // the same at any step) until it reaches the truth's tolerance (d = 4 sooner).
     Curve c;
-    c.key = "pim-switching";
-    c.label = "switching PIM d=2 (order 5), banded";
+    c.key = degree == 2 ? "pim-switching" : fmt::format("pim-switching-d{}", degree);
+    c.label = fmt::format("switching PIM d={} (order {}), banded", degree, degree + 3);
     c.parameter_name = "steps/s";
     c.fixed_step = true;
-    const std::vector<int> per_second = o.quick ? std::vector<int>{10, 50}
-                                                : std::vector<int>{2, 4, 10, 25, 50, 100, 200};
+    const std::vector<int> per_second =
+        o.quick ? std::vector<int>{10, 50}
+        : degree == 2 ? std::vector<int>{2, 4, 10, 25, 50, 100, 200}
+                      : std::vector<int>{2, 4, 5, 10, 25, 50};
     for (int n : per_second) {
-      const MethodSettings settings = at_step(Method::pim_switching_banded, 1.0 / n);
+      MethodSettings settings = at_step(Method::pim_switching_banded, 1.0 / n);
+      settings.force_degree = degree;
       const Factory make = table_factory(s, settings);
       c.points.push_back({double(n), settings.step,
                           accuracy_detail::measure(make, times, truth, o.repeats, o.budget)});

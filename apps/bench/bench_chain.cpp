@@ -15,6 +15,7 @@
 #include "output/csv_writer.hpp"
 #include "pwl/errors.hpp"
 #include "pwl/integrators/accuracy_step.hpp"
+#include "pwl/integrators/banded_step_operators.hpp"
 #include "pwl/integrators/banded_step_rule.hpp"
 #include "pwl/integrators/method_table.hpp"
 #include "pwl/model/chain_builders.hpp"
@@ -92,6 +93,43 @@ const ChainMethodResult* fastest_pwl_row_as_accurate_as(const ChainBenchResult& 
   return best;
 }
 
+// The floor at step η and band q (0: from the tolerance): T = exp(Hη) built as the banded
+// steppers build it (make_banded_step_operators, from the period), and the median wall time of
+// one bare T v over 7 repeats of about 10 ms each.
+ChainFloorRow measure_floor(const GapStructure& structure, double t_end, double step, int band) {
+  BandedExponentialOptions options;
+  options.band = band;
+  const BandedStepOperators ops = make_banded_step_operators(structure, step, options);
+  const BandedMatrix& T = ops.transition;
+  Vector state = Vector::Ones(T.cols()), out(T.rows());
+  volatile double sink = 0.0;
+  const auto products = [&](long calls) {
+    const auto t0 = std::chrono::steady_clock::now();
+    for (long k = 0; k < calls; ++k) {
+      T.multiply(state.data(), out.data());
+      sink = sink + out[0];
+    }
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() /
+           static_cast<double>(calls);
+  };
+  const long calls = std::max<long>(1, std::lround(0.01 / std::max(products(3), 1e-9)));
+  std::vector<double> per;
+  for (int r = 0; r < 7; ++r) per.push_back(products(calls));
+  ChainFloorRow row;
+  row.step = step;
+  row.band = band;
+  row.chosen_band = ops.truncation.band;
+  row.width = T.width();
+  row.transition_product = median(per);
+  row.steps = static_cast<long>(std::ceil(t_end / step - 1e-9));
+  return row;
+}
+
+// Whether a row runs a banded PIM on a fixed grid (its steps each multiply by T once).
+bool banded_fixed_step(const std::string& key) {
+  return key == "pim-banded" || key == "pim-rule" || key == "pim-switching" || key == "pim-rtol";
+}
+
 }  // namespace
 
 std::vector<std::string> chain_bench_methods() {
@@ -103,6 +141,17 @@ ChainBenchResult run_chain_bench(const ChainBenchOptions& o) {
   for (double step : o.switching_steps) {
     if (!(step > 0.0) || !std::isfinite(step)) {
       throw InputError(fmt::format("bench chain: switching step = {} must be positive and finite",
+                                   step));
+    }
+  }
+  for (int degree : o.switching_degrees) {
+    if (degree < 0 || degree > 8) {
+      throw InputError(fmt::format("bench chain: switching degree = {} must be in 0 .. 8", degree));
+    }
+  }
+  for (double step : o.floor_steps) {
+    if (!(step > 0.0) || !std::isfinite(step)) {
+      throw InputError(fmt::format("bench chain: floor step = {} must be positive and finite",
                                    step));
     }
   }
@@ -184,11 +233,14 @@ ChainBenchResult run_chain_bench(const ChainBenchOptions& o) {
     }
   }
   if (wanted("pim-switching")) {
-    for (double step : o.switching_steps) {
-      methods.push_back({"pim-switching", "banded switching PIM",
-                         fmt::format("η = {:g} s, order 5, switches located", step), o.runs,
-                         fixed_step(Method::pim_switching_banded, step), false, std::nullopt,
-                         std::nullopt});
+    for (int degree : o.switching_degrees) {
+      for (double step : o.switching_steps) {
+        MethodSettings settings = fixed_step(Method::pim_switching_banded, step);
+        settings.force_degree = degree;
+        methods.push_back({"pim-switching", "banded switching PIM",
+                           fmt::format("η = {:g} s, order {}, switches located", step, degree + 3),
+                           o.runs, settings, false, std::nullopt, std::nullopt});
+      }
     }
   }
   const Vector rest = Vector::Zero(o.masses);
@@ -198,13 +250,16 @@ ChainBenchResult run_chain_bench(const ChainBenchOptions& o) {
       request.relative_tolerance = rtol;
       request.period = o.t_end;  // the step divides the run (its end is on the grid)
       request.probe = std::min(o.t_end, 4 * M_PI);  // two periods of the loads (sin 3t, sin 5t)
+      request.force_degrees = {2, 4, 6};            // as `--rtol` chooses (case_options.cpp)
       MethodSettings settings = fixed_step(Method::pim_switching_banded, 0.0);
-      // The step it finds, for the label; the timed runs find it again.
+      // The step and degree it finds, for the label; the timed runs find them again.
       const AccuracyStep chosen = step_for_accuracy(structure, settings, 0.0, rest, rest, request);
-      methods.push_back({"pim-rtol", "banded switching PIM (--rtol)",
-                         fmt::format("rtol = {:g} -> η = {:.4g} s (estimate {:.1e} on [0, {:.3g}] s)",
-                                     rtol, chosen.step, chosen.estimated_error, request.probe),
-                         o.runs, settings, false, std::nullopt, request});
+      methods.push_back(
+          {"pim-rtol", "banded switching PIM (--rtol)",
+           fmt::format("rtol = {:g} -> η = {:.4g} s, order {} (estimate {:.1e} on [0, {:.3g}] s)",
+                       rtol, chosen.step, chosen.force_degree + 3, chosen.estimated_error,
+                       request.probe),
+           o.runs, settings, false, std::nullopt, request});
     }
   }
   if (wanted("pim-dense")) {
@@ -228,7 +283,10 @@ ChainBenchResult run_chain_bench(const ChainBenchOptions& o) {
     MethodSettings settings = m.settings;
     if (m.rule) settings.step = select_banded_step(structure, *m.rule).step;
     if (m.accuracy) {
-      settings.step = step_for_accuracy(structure, settings, 0.0, rest, rest, *m.accuracy).step;
+      const AccuracyStep chosen =
+          step_for_accuracy(structure, settings, 0.0, rest, rest, *m.accuracy);
+      settings.step = chosen.step;
+      settings.force_degree = chosen.force_degree;
     }
     return make_integrator(structure, settings);
   };
@@ -241,6 +299,7 @@ ChainBenchResult run_chain_bench(const ChainBenchOptions& o) {
     r.parameters = m.parameters;
     r.runs = m.runs;
     r.base = m.base;
+    const int band = m.settings.band;
     std::vector<double> walls, cpus, setups;
     for (int run = 0; run < m.runs; ++run) {
       TrackRecord record;
@@ -270,7 +329,23 @@ ChainBenchResult run_chain_bench(const ChainBenchOptions& o) {
     r.setup = median(setups);
     std::tie(r.error_x, r.error_v) = largest_errors(r.record, result.reference);
     say(fmt::format("  largest error: x1 {:.2e} m, x1' {:.2e} m/s", r.error_x, r.error_v));
+    if (banded_fixed_step(r.key) && r.steps > 0) {
+      // The row's own floor: its step is what divides the run into its steps.
+      const ChainFloorRow floor =
+          measure_floor(structure, o.t_end, o.t_end / static_cast<double>(r.steps), band);
+      r.floor = floor.floor();
+      say(fmt::format("  floor: {} steps x {:.2f} us (bare T v, q = {}) = {:.3g} s; the run after its "
+                      "set-up is {:.2f} T v per step",
+                      floor.steps, 1e6 * floor.transition_product, floor.chosen_band, r.floor,
+                      (r.wall - r.setup) / r.floor));
+    }
     result.methods.push_back(std::move(r));
+  }
+  for (double step : o.floor_steps) {
+    result.floors.push_back(measure_floor(structure, o.t_end, step, 0));
+    const ChainFloorRow& f = result.floors.back();
+    say(fmt::format("floor at η = {:g} s: q = {}, T v {:.2f} us, {} steps: {:.3g} s", f.step,
+                    f.chosen_band, 1e6 * f.transition_product, f.steps, f.floor()));
   }
 
   // CSV: one row per method.
@@ -280,17 +355,70 @@ ChainBenchResult run_chain_bench(const ChainBenchOptions& o) {
     if (f == nullptr) throw Error(fmt::format("cannot write {}/bench_chain.csv", o.out));
     fmt::print(f,
                "key,method,parameters,runs,wall_median_s,cpu_median_s,setup_median_s,steps,"
-               "work,error_x1,error_v1,time_vs_banded,error_x1_vs_banded\n");
+               "work,error_x1,error_v1,time_vs_banded,error_x1_vs_banded,floor_s\n");
     for (const ChainMethodResult& r : result.methods) {
-      fmt::print(f, "{},\"{}\",\"{}\",{},{:.6g},{:.6g},{:.6g},{},{},{:.6e},{:.6e},{:.6g},{:.6g}\n",
+      fmt::print(f, "{},\"{}\",\"{}\",{},{:.6g},{:.6g},{:.6g},{},{},{:.6e},{:.6e},{:.6g},{:.6g},{:.6g}\n",
                  r.key, r.label, r.parameters, r.runs, r.wall, r.cpu, r.setup, r.steps, r.work,
                  r.error_x, r.error_v, base ? r.wall / base->wall : 0.0,
-                 base ? r.error_x / base->error_x : 0.0);
+                 base ? r.error_x / base->error_x : 0.0, r.floor);
+    }
+    std::fclose(f);
+  }
+  {
+    std::FILE* f = std::fopen((o.out + "/bench_chain_floor.csv").c_str(), "w");
+    if (f == nullptr) throw Error(fmt::format("cannot write {}/bench_chain_floor.csv", o.out));
+    fmt::print(f, "step_s,band,width,transition_product_s,steps,floor_s\n");
+    for (const ChainFloorRow& r : result.floors) {
+      fmt::print(f, "{:.6g},{},{},{:.6e},{},{:.6g}\n", r.step, r.chosen_band, r.width,
+                 r.transition_product, r.steps, r.floor());
     }
     std::fclose(f);
   }
   return result;
 }
+
+namespace {
+
+// The floor of each banded row, and the floor by step against each dopri5 row.
+std::string format_floor_tables(const ChainBenchResult& result) {
+  std::string s;
+  bool any = false;
+  for (const ChainMethodResult& r : result.methods) {
+    if (!(r.floor > 0.0)) continue;
+    if (!any) {
+      s += "\nThe floor: a banded PIM step multiplies the state by T = exp(Hη) once, so steps x "
+           "one bare T v is the least a run at that step costs (T v timed alone, same q).\n"
+           "| method | parameters | steps | floor s | (wall - set-up) / floor (T v per step) |\n"
+           "|---|---|---|---|---|\n";
+      any = true;
+    }
+    s += fmt::format("| {} | {} | {} | {:.3g} | {:.2f} |\n", r.label, r.parameters, r.steps,
+                     r.floor, (r.wall - r.setup) / r.floor);
+  }
+  if (result.floors.empty()) return s;
+  std::vector<const ChainMethodResult*> rivals;
+  for (const ChainMethodResult& r : result.methods) {
+    if (r.key.rfind("dopri5", 0) == 0) rivals.push_back(&r);
+  }
+  s += "\nThe floor by step (q from the tolerance 1e-15): its speed-up over a dopri5 row is the "
+       "most a step costing one T v could reach there, before its accuracy is asked.\n"
+       "| η (s) | q | diagonals of T | T v (us) | steps | floor s |";
+  std::string rule = "|---|---|---|---|---|---|";
+  for (const ChainMethodResult* r : rivals) {
+    s += fmt::format(" {} / floor |", r->key);
+    rule += "---|";
+  }
+  s += "\n" + rule + "\n";
+  for (const ChainFloorRow& f : result.floors) {
+    s += fmt::format("| {:g} | {} | {} | {:.2f} | {} | {:.3g} |", f.step, f.chosen_band, f.width,
+                     1e6 * f.transition_product, f.steps, f.floor());
+    for (const ChainMethodResult* r : rivals) s += fmt::format(" {:.1f} |", r->wall / f.floor());
+    s += "\n";
+  }
+  return s;
+}
+
+}  // namespace
 
 std::string format_chain_table(const ChainBenchResult& result) {
   const ChainBenchOptions& o = result.options;
@@ -330,6 +458,7 @@ std::string format_chain_table(const ChainBenchResult& result) {
                      r.error_v, base ? fmt::format("{:.2f}", r.wall / base->wall) : "-",
                      base ? fmt::format("{:.2f}", r.error_x / base->error_x) : "-");
   }
+  s += format_floor_tables(result);
   s += "\nThe paper (Table 1, MATLAB on an i7-5600U): this method 8.3 s, ode45 at 1e-5 41.4 s "
        "(5.0x), at 1e-10 462.7 s (55.7x); the method about 10x more accurate than ode45 at "
        "1e-5.\n";

@@ -6,6 +6,13 @@
 // 1e-10, plain (like the paper's ode45) and kink-located. For each: the median wall and CPU time
 // of several runs and the largest error of x1 and x1' against a kink-located reference at 1e-12;
 // then, for each dopri5 row, the fastest pwl row at or below both its errors and how much faster.
+//
+// And the floor each banded row stands on: every banded PIM step (smooth steps; a switching step
+// redoes its motion on the Taylor series instead) multiplies the state by T = exp(Hη) once, so
+// steps x (one bare product T v) is the least a run at that step can cost, whatever else the
+// step does. Measured for each banded row (its wall time over that floor is its cost in T v
+// products per step) and for a range of steps (the floor's speed-up over each dopri5 row is the
+// most any method of this family could reach at that step, before asking for its accuracy).
 #include <optional>
 #include <string>
 #include <vector>
@@ -23,12 +30,19 @@ struct ChainBenchOptions {
   double paper_step = 0.02;    // s, the step the paper reports
   double wished_step = 0.32;   // s, η1 given to the step rule
   std::vector<int> rule_bands{5, 8};  // q given to the step rule (the paper: 5, its 11-dof piece)
-  // Steps of the banded switching PIM (order 5, switches located), one row each.
-  std::vector<double> switching_steps{0.2, 0.1, 0.08, 0.04, 0.02};
+  // Steps of the banded switching PIM (switches located), one row each per degree. At 0.8 s
+  // (η ω_max = 1.8) every step of the paper's chain has a spring near its kink and is redone on
+  // the Taylor series to rounding, so those rows are exact whatever the degree.
+  std::vector<double> switching_steps{0.8, 0.4, 0.2, 0.1, 0.08, 0.04, 0.02};
+  // Force degrees d of those rows (order d + 3), one set of rows each.
+  std::vector<int> switching_degrees{2, 4, 6};
   // Accuracy requests for the banded switching PIM (accuracy_step.hpp), one row each: the step
   // (dividing t_end) found on the first two periods of the loads (4π s) and the run at it, both
   // timed.
   std::vector<double> accuracy_requests{1e-6, 1e-9};
+  // Steps of the floor table (one bare T v each, timed; the switching PIM refuses steps with
+  // η ω_max > 2, 0.89 s on the paper's chain).
+  std::vector<double> floor_steps{0.02, 0.05, 0.1, 0.2, 0.4, 0.5, 0.8};
   bool without_dense = false;         // leave the dense PIM out (minutes per run at n = 1000)
   double reference_tolerance = 1e-12;
   double reference_grid = 0.005;      // s, spacing of the reference's recorded points
@@ -58,6 +72,20 @@ struct ChainMethodResult {
   double error_x = 0.0;     // largest |x1 - reference| over the run, m
   double error_v = 0.0;     // largest |x1' - reference|, m/s
   TrackRecord record;       // x1, x1' at every step of the first run
+  // Banded fixed-step rows: the floor at the row's step and band (steps x one bare T v), s;
+  // 0 for the other rows.
+  double floor = 0.0;
+};
+
+// One bare product with the banded T = exp(Hη) at a step, and the least a run of t_end costs.
+struct ChainFloorRow {
+  double step = 0.0;               // η, s
+  int band = 0;                    // q forced (0: from the tolerance 1e-15, as the rows build it)
+  Index chosen_band = 0;           // q the construction chose
+  Index width = 0;                 // stored diagonals of T on the interleaved state
+  double transition_product = 0.0; // median wall time of one T v, s
+  long steps = 0;                  // steps of the run (t_end / η, rounded up)
+  double floor() const { return static_cast<double>(steps) * transition_product; }
 };
 
 struct ChainBenchResult {
@@ -68,9 +96,11 @@ struct ChainBenchResult {
   double reference_seconds = 0.0;
   std::optional<std::pair<double, double>> reference_check;  // |rkf78 - dopri5| in x1, x1'
   std::vector<BandedStepChoice> rule_choices;                 // per rule band
+  std::vector<ChainFloorRow> floors;                          // options.floor_steps, then the rows'
 };
 
-// Runs the benchmark (printing progress unless quiet) and writes <out>/bench_chain.csv.
+// Runs the benchmark (printing progress unless quiet) and writes <out>/bench_chain.csv and
+// <out>/bench_chain_floor.csv.
 ChainBenchResult run_chain_bench(const ChainBenchOptions& options);
 
 // The table with the paper's beside it, and the targets met or missed.

@@ -59,12 +59,22 @@ void add_chain(CLI::App& bench) {
                 "Steps of the banded switching PIM rows (s), comma separated")
       ->delimiter(',')
       ->check(positive_number());
+  c->add_option("--switching-degrees", o->switching_degrees,
+                "Force degrees d of the banded switching PIM rows (order d + 3), comma separated:\n"
+                "one row per step and degree")
+      ->delimiter(',')
+      ->check(number_in(0, 8));
   c->add_option("--rtol-rows", o->accuracy_requests,
                 "Accuracy requests (--rtol) of the banded switching PIM rows, comma separated:\n"
                 "the step chosen on the loads' first two periods, choice and run timed together")
       ->delimiter(',')
       ->check(positive_number())
       ->check(number_in(kSmallestRelativeTolerance, 0.5));
+  c->add_option("--floor-steps", o->floor_steps,
+                "Steps of the floor table (s), comma separated: one bare product T v timed at\n"
+                "each, times the run's steps")
+      ->delimiter(',')
+      ->check(positive_number());
   c->add_option("--methods", o->methods,
                 "Only these methods: pim-banded, pim-rule, pim-switching, pim-rtol, pim-dense, dopri5-1e-5, "
                 "dopri5-1e-10, dopri5-1e-5-kinks, dopri5-1e-10-kinks")

@@ -1,7 +1,8 @@
 // The step for a requested accuracy (accuracy_step.hpp): the chosen step meets the request
 // against a kink-located rkf78 reference at 1e-12 on a chain whose cells vary, without being
-// needlessly short, for the switching PIM (banded, order 5) and the paper's PIM; and bad
-// requests are refused by name.
+// needlessly short, for the switching PIM (banded, order 5), the switching PIM choosing its force
+// degree among 2, 4 and 6 too (a step at least as long as degree 2's alone) and the paper's PIM;
+// and bad requests are refused by name.
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -77,11 +78,16 @@ TEST_CASE("accuracy request: the chosen step meets it against kink-located rkf78
   struct Case {
     Method method;
     double tolerance;
+    std::vector<int> degrees;
     AccuracyStep chosen;
   };
-  std::vector<Case> cases{{Method::pim_switching, 1e-5, {}},
-                          {Method::pim_switching, 1e-8, {}},
-                          {Method::pim, 1e-3, {}}};
+  const std::vector<int> degrees{2, 4, 6};
+  std::vector<Case> cases{{Method::pim_switching, 1e-5, {}, {}},
+                          {Method::pim_switching, 1e-8, {}, {}},
+                          {Method::pim_switching, 1e-5, degrees, {}},
+                          {Method::pim_switching, 1e-8, degrees, {}},
+                          {Method::pim_switching, 1e-3, degrees, {}},
+                          {Method::pim, 1e-3, {}, {}}};
   // The steps first, then one reference run through every step end of every case.
   std::vector<double> all_times;
   for (Case& c : cases) {
@@ -91,6 +97,7 @@ TEST_CASE("accuracy request: the chosen step meets it against kink-located rkf78
     request.relative_tolerance = c.tolerance;
     request.period = period;
     request.probe = horizon;
+    request.force_degrees = c.degrees;
     c.chosen = step_for_accuracy(s, m, 0.0, zero, zero, request);
     for (long k = 1; k <= 2 * c.chosen.steps_per_period; ++k) all_times.push_back(k * c.chosen.step);
   }
@@ -102,6 +109,7 @@ TEST_CASE("accuracy request: the chosen step meets it against kink-located rkf78
     MethodSettings m;
     m.method = c.method;
     m.step = chosen.step;
+    if (takes_force_degree(method_traits(c.method))) m.force_degree = chosen.force_degree;
     // Every step's end over the horizon, against the reference at the same times.
     std::vector<double> times;
     std::vector<Vector> truth;
@@ -113,16 +121,35 @@ TEST_CASE("accuracy request: the chosen step meets it against kink-located rkf78
     auto integrator = make_integrator(s, m);
     const double error = relative_error(states(*integrator, times), truth, n);
     INFO(method_traits(c.method).name << " at rtol " << c.tolerance << ": T/"
-                                      << chosen.steps_per_period << " after " << chosen.candidates
+                                      << chosen.steps_per_period << " (d = " << chosen.force_degree
+                                      << ") after " << chosen.candidates
                                       << " candidates, estimate " << chosen.estimated_error
                                       << ", measured " << error << ", guard's largest step "
                                       << chosen.largest_step);
     CHECK(chosen.step == Approx(period / static_cast<double>(chosen.steps_per_period)));
     CHECK(chosen.estimated_error <= c.tolerance);
     CHECK(error <= c.tolerance);
-    CHECK(error >= 1e-3 * c.tolerance);
+    // Not needlessly short: within 1e-3 of the tolerance, or the longest step the guard lets
+    // through (a high degree can be far more accurate than asked there).
+    const bool longest = chosen.steps_per_period ==
+                         static_cast<long>(std::ceil(period / chosen.largest_step - 1e-9));
+    CHECK((error >= 1e-3 * c.tolerance || (!c.degrees.empty() && longest)));
     CHECK(chosen.step <= chosen.largest_step * (1 + 1e-12));
+    if (c.method == Method::pim) CHECK(chosen.force_degree == -1);
+    if (c.method == Method::pim_switching && c.degrees.empty()) CHECK(chosen.force_degree == 2);
   }
+  // With the degrees to choose from, a step at least as long as degree 2's alone, and (checked by
+  // hand on this chain) the highest degree where accuracy is asked, the lowest where it is not.
+  for (std::size_t k = 0; k < 2; ++k) {
+    const AccuracyStep& alone = cases[k].chosen;
+    const AccuracyStep& chosen = cases[k + 2].chosen;
+    INFO("rtol " << cases[k].tolerance << ": d = 2 alone T/" << alone.steps_per_period
+                 << ", chosen d = " << chosen.force_degree << " T/" << chosen.steps_per_period);
+    CHECK(chosen.steps_per_period <= alone.steps_per_period);
+  }
+  CHECK(cases[3].chosen.force_degree == 6);
+  CHECK(cases[3].chosen.steps_per_period * 2 <= cases[1].chosen.steps_per_period);
+  CHECK(cases[4].chosen.force_degree == 2);
 }
 
 TEST_CASE("accuracy request: bad requests are refused by name", "[accuracy]") {
@@ -164,4 +191,14 @@ TEST_CASE("accuracy request: bad requests are refused by name", "[accuracy]") {
   bad.max_steps_per_period = 20;
   CHECK_THAT(message(m, bad), Catch::Contains("relative tolerance = 1e-10: pim-switching does not "
                                               "reach it on this structure within 20 steps"));
+  bad = r;
+  bad.force_degrees = {2, 9};
+  CHECK_THAT(message(m, bad), Catch::Contains("force_degrees: degree 9 is not in 0 .. 8"));
+  bad.force_degrees = {-1};
+  CHECK_THAT(message(m, bad), Catch::Contains("force_degrees: degree -1 is not in 0 .. 8"));
+  MethodSettings plain;
+  plain.method = Method::pim;
+  bad = r;
+  bad.force_degrees = {2, 4};
+  CHECK_THAT(message(plain, bad), Catch::Contains("force_degrees = [2, 4]: pim takes no force degree"));
 }

@@ -153,6 +153,10 @@ void add_case_options(CLI::App& c, CaseOptions& o) {
       ->excludes(spp)
       ->excludes(dt);
   c.add_option("--method", o.method, method_help())->check(CLI::IsMember(method_names()));
+  c.add_option("--force-degree", o.force_degree,
+               "Switching PIM: derivatives d of the spring forces used (order d + 3), 0 .. 8;\n"
+               "default 2, or with --rtol chosen with the step from 2, 4 and 6")
+      ->check(number_in(0, 8));
   c.add_option("--tol", o.tolerance, "Relative and absolute tolerance of dopri5/rkf78")
       ->check(positive_number());
   c.add_flag("--locate-kinks", o.locate_kinks,
@@ -234,16 +238,43 @@ int CaseOptions::grid_steps(double period) const {
   request.period = period;
   request.probe = std::min(periods, 4) * period;
   request.max_steps_per_period = std::numeric_limits<int>::max() / 2;
+  if (takes_force_degree(method_traits(m))) {
+    if (force_degree >= 0) {
+      settings.force_degree = force_degree;
+    } else {
+      request.force_degrees = {2, 4, 6};
+    }
+  }
   std::string why;
   if (!request.is_valid(&why)) throw InputError("--rtol: " + why);
   const AccuracyStep chosen = step_for_accuracy(s, settings, 0.0, y.head(n), y.tail(n), request);
   rtol_steps = chosen.steps_per_period;
+  rtol_degree = chosen.force_degree;
   fmt::print(stderr,
-             "pwl: note: --rtol {:g}: η = T/{} = {:.6g} (estimated error {:.2g} over the first {} "
-             "periods; {} steps tried)\n",
-             rtol, chosen.steps_per_period, chosen.step, chosen.estimated_error,
-             std::min(periods, 4), chosen.candidates);
+             "pwl: note: --rtol {:g}: η = T/{} = {:.6g}{} (estimated error {:.2g} over the first "
+             "{} periods; {} steps tried)\n",
+             rtol, chosen.steps_per_period, chosen.step,
+             chosen.force_degree >= 0 ? fmt::format(", force degree {}", chosen.force_degree) : "",
+             chosen.estimated_error, std::min(periods, 4), chosen.candidates);
   return static_cast<int>(rtol_steps);
+}
+
+int CaseOptions::switching_degree(double period) const {
+  const MethodTraits& traits = method_traits(parse_method(method));
+  if (!takes_force_degree(traits)) {
+    if (force_degree >= 0) {
+      throw InputError(fmt::format("--force-degree = {}: {} takes no force degree (the switching "
+                                   "PIM does)",
+                                   force_degree, traits.name));
+    }
+    return MethodSettings{}.force_degree;
+  }
+  if (force_degree >= 0) return force_degree;
+  if (rtol > 0.0) {
+    grid_steps(period);
+    return rtol_degree;
+  }
+  return MethodSettings{}.force_degree;
 }
 
 double CaseOptions::step(double period) const {
@@ -276,6 +307,7 @@ MethodSettings CaseOptions::method_settings(double period) const {
   MethodSettings m;
   m.method = parse_method(method);
   if (method_traits(m.method).fixed_grid || rtol > 0.0) m.step = step(period);  // --rtol: checks the method
+  m.force_degree = switching_degree(period);
   m.tolerance = tolerance;
   m.locate_kinks = locate_kinks;
   m.max_step = period / 8;

@@ -70,6 +70,9 @@ struct CaseOptions {
   // dt: the largest step T/N whose estimated error over the first periods meets it.
   double rtol = 0.0;
   std::string method = "pim";  // a name of the method table (method_names())
+  // The switching PIM's force degree d (order d + 3), 0 .. 8; -1: not given (2, or with --rtol
+  // chosen from 2, 4 and 6 with the step: accuracy_step.hpp).
+  int force_degree = -1;
   double tolerance = 1e-10;
   bool locate_kinks = false;
   std::string lcp_solver = "block-pivoting";
@@ -79,6 +82,7 @@ struct CaseOptions {
   InitialStateFlags start;  // --x0, --v0
   bool force = false;       // --force: run a step the step guard refuses
   mutable long rtol_steps = 0;  // what --rtol chose (0: not yet)
+  mutable int rtol_degree = -1;  // and the switching PIM's degree it chose (-1: none)
 
   // The chain these flags describe (the preset, then each given flag).
   NondimensionalChain chain() const;
@@ -99,6 +103,9 @@ struct CaseOptions {
   double step(double period) const;
   // Steps per forcing period: steps_per_period, or the number --rtol chose.
   int grid_steps(double period) const;
+  // The switching PIM's force degree: --force-degree, or what --rtol chose, or 2. Throws
+  // InputError when --force-degree is given to a method that takes none.
+  int switching_degree(double period) const;
   // The method table's settings these flags give (the step only for fixed-grid methods; for the
   // exact solver, its progress on stderr during a long advance: step_guard_report.hpp).
   MethodSettings method_settings(double period) const;

@@ -3,9 +3,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <string_view>
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "pwl/errors.hpp"
 #include "pwl/integrators/step_guard.hpp"
@@ -35,6 +38,9 @@ bool AccuracyRequest::is_valid(std::string* why) const {
   }
   if (max_steps_per_period < 1) {
     return bad(fmt::format("max_steps_per_period = {} must be at least 1", max_steps_per_period));
+  }
+  for (int d : force_degrees) {
+    if (d < 0 || d > 8) return bad(fmt::format("force_degrees: degree {} is not in 0 .. 8", d));
   }
   return true;
 }
@@ -75,6 +81,68 @@ double relative_difference(const std::vector<Vector>& a, const std::vector<Vecto
   return std::max(ex, ev);
 }
 
+// The estimated relative error of the step period / steps for `settings` on the probe: twice the
+// difference of the runs at η and η/2 at about 50 common grid points (multiples of η); the
+// difference itself in *difference.
+double estimate_error(const GapStructure& structure, const MethodSettings& settings, long steps,
+                      double t0, const Vector& x0, const Vector& v0,
+                      const AccuracyRequest& request, double* difference) {
+  const double step = request.period / static_cast<double>(steps);
+  const long total = std::max<long>(1, static_cast<long>(std::ceil(request.probe / step - 1e-9)));
+  const long stride = std::max<long>(1, total / 50);
+  const long points = std::max<long>(1, total / stride);
+  const std::vector<Vector> coarse =
+      probe_states(structure, settings, step, t0, x0, v0, points, stride);
+  const std::vector<Vector> fine =
+      probe_states(structure, settings, step / 2, t0, x0, v0, points, 2 * stride);
+  *difference = relative_difference(coarse, fine, structure.dofs());
+  return 2.0 * *difference;
+}
+
+// From `steps` per period on, the largest step whose estimate meets the request, for a method of
+// order `order` (the loop of the file comment). Adds its candidates to out.candidates.
+void search_step(const GapStructure& structure, const MethodSettings& settings, int order,
+                 long steps, double t0, const Vector& x0, const Vector& v0,
+                 const AccuracyRequest& request, AccuracyStep& out) {
+  const std::string_view name = method_traits(settings.method).name;
+  double best = -1.0;
+  long best_steps = 0;
+  while (true) {
+    if (steps > request.max_steps_per_period) {
+      throw InputError(fmt::format(
+          "relative tolerance = {:.3g}: {} does not reach it on this structure within {} steps "
+          "per period (the best estimate, at T/{}, is {:.3g})",
+          request.relative_tolerance, name, request.max_steps_per_period, best_steps, best));
+    }
+    double difference = 0.0;
+    const double estimate =
+        estimate_error(structure, settings, steps, t0, x0, v0, request, &difference);
+    ++out.candidates;
+    if (best < 0.0 || estimate < best) {
+      best = estimate;
+      best_steps = steps;
+    }
+    if (estimate <= request.relative_tolerance) {
+      out.steps_per_period = steps;
+      out.step = request.period / static_cast<double>(steps);
+      out.estimated_error = estimate;
+      return;
+    }
+    // At rounding the halving no longer changes the motion: smaller steps cannot help.
+    if (difference < 1e-13) {
+      throw InputError(fmt::format(
+          "relative tolerance = {:.3g}: below what {} reaches on this structure (the estimate "
+          "stays at {:.3g}, rounding)",
+          request.relative_tolerance, name, estimate));
+    }
+    // The step the estimate asks for, and at least a tenth shorter (an estimate outside its
+    // asymptotic range can promise too much).
+    const double factor = std::pow(0.8 * request.relative_tolerance / estimate, 1.0 / order);
+    const auto next = static_cast<long>(std::ceil(static_cast<double>(steps) / std::min(0.9, factor)));
+    steps = std::max(next, steps + 1);
+  }
+}
+
 }  // namespace
 
 AccuracyStep step_for_accuracy(const GapStructure& structure, const MethodSettings& base,
@@ -89,60 +157,43 @@ AccuracyStep step_for_accuracy(const GapStructure& structure, const MethodSettin
         "chooses its own steps: give it its tolerance instead",
         traits.name));
   }
-  const bool switching = base.method == Method::pim_switching ||
-                         base.method == Method::pim_switching_dense ||
-                         base.method == Method::pim_switching_banded;
-  const int order = switching ? base.force_degree + 3 : std::max(1, traits.order);
-  const double omega = contact_frequency(structure).omega_max;
-  const double period = request.period;
-  AccuracyStep out;
-  out.largest_step = traits.step_warning > 0.0 && omega > 0.0 ? traits.step_warning / omega : period;
-  long steps = std::max<long>(1, static_cast<long>(std::ceil(period / out.largest_step - 1e-9)));
-  const Index n = structure.dofs();
-  double best = -1.0;
-  long best_steps = 0;
-  while (true) {
-    if (steps > request.max_steps_per_period) {
-      throw InputError(fmt::format(
-          "relative tolerance = {:.3g}: {} does not reach it on this structure within {} steps "
-          "per period (the best estimate, at T/{}, is {:.3g})",
-          request.relative_tolerance, traits.name, request.max_steps_per_period, best_steps,
-          best));
-    }
-    const double step = period / static_cast<double>(steps);
-    // Compare at about 50 grid points of the probe (multiples of η, on both grids).
-    const long total = std::max<long>(1, static_cast<long>(std::ceil(request.probe / step - 1e-9)));
-    const long stride = std::max<long>(1, total / 50);
-    const long points = std::max<long>(1, total / stride);
-    const std::vector<Vector> coarse = probe_states(structure, base, step, t0, x0, v0, points, stride);
-    const std::vector<Vector> fine =
-        probe_states(structure, base, step / 2, t0, x0, v0, points, 2 * stride);
-    ++out.candidates;
-    const double difference = relative_difference(coarse, fine, n);
-    const double estimate = 2.0 * difference;
-    if (best < 0.0 || estimate < best) {
-      best = estimate;
-      best_steps = steps;
-    }
-    if (estimate <= request.relative_tolerance) {
-      out.steps_per_period = steps;
-      out.step = step;
-      out.estimated_error = estimate;
-      return out;
-    }
-    // At rounding the halving no longer changes the motion: smaller steps cannot help.
-    if (difference < 1e-13) {
-      throw InputError(fmt::format(
-          "relative tolerance = {:.3g}: below what {} reaches on this structure (the estimate "
-          "stays at {:.3g}, rounding)",
-          request.relative_tolerance, traits.name, estimate));
-    }
-    // The step the estimate asks for, and at least a tenth shorter (an estimate outside its
-    // asymptotic range can promise too much).
-    const double factor = std::pow(0.8 * request.relative_tolerance / estimate, 1.0 / order);
-    const auto next = static_cast<long>(std::ceil(static_cast<double>(steps) / std::min(0.9, factor)));
-    steps = std::max(next, steps + 1);
+  const bool switching = takes_force_degree(traits);
+  if (!request.force_degrees.empty() && !switching) {
+    throw InputError(fmt::format("accuracy request: force_degrees = [{}]: {} takes no force "
+                                 "degree (the switching PIM does)",
+                                 fmt::join(request.force_degrees, ", "), traits.name));
   }
+  const double omega = contact_frequency(structure).omega_max;
+  AccuracyStep out;
+  out.largest_step =
+      traits.step_warning > 0.0 && omega > 0.0 ? traits.step_warning / omega : request.period;
+  const long first =
+      std::max<long>(1, static_cast<long>(std::ceil(request.period / out.largest_step - 1e-9)));
+  if (request.force_degrees.empty()) {
+    const int order = switching ? base.force_degree + 3 : std::max(1, traits.order);
+    search_step(structure, base, order, first, t0, x0, v0, request, out);
+    out.force_degree = switching ? base.force_degree : -1;
+    return out;
+  }
+  // The highest degree finds the step; the lower ones are kept while they meet it there.
+  std::vector<int> degrees = request.force_degrees;
+  std::sort(degrees.begin(), degrees.end(), std::greater<>());
+  degrees.erase(std::unique(degrees.begin(), degrees.end()), degrees.end());
+  MethodSettings settings = base;
+  settings.force_degree = degrees.front();
+  search_step(structure, settings, degrees.front() + 3, first, t0, x0, v0, request, out);
+  out.force_degree = degrees.front();
+  for (std::size_t k = 1; k < degrees.size(); ++k) {
+    settings.force_degree = degrees[k];
+    double difference = 0.0;
+    const double estimate = estimate_error(structure, settings, out.steps_per_period, t0, x0, v0,
+                                           request, &difference);
+    ++out.candidates;
+    if (!(estimate <= request.relative_tolerance)) break;
+    out.force_degree = degrees[k];
+    out.estimated_error = estimate;
+  }
+  return out;
 }
 
 }  // namespace pwl

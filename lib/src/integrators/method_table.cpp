@@ -188,6 +188,9 @@ Method parse_method(std::string_view name) {
 
 std::string method_label(const MethodSettings& s) {
   const MethodTraits& row = method_traits(s.method);
+  if (takes_force_degree(row) && s.force_degree != MethodSettings{}.force_degree) {
+    return fmt::format("{}, d = {}", row.label, s.force_degree);
+  }
   if (!row.adaptive) return std::string(row.label);
   return fmt::format("{}{}, tol {:g}", row.name, s.locate_kinks ? ", kink-located" : "",
                      s.tolerance);

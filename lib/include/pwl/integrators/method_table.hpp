@@ -96,14 +96,20 @@ struct MethodSettings {
   MethodSettings for_period(double period, int steps_per_period) const;
 };
 
-// The method's label with the settings a reader needs to repeat the run: "PIM", "switching PIM",
-// "dopri5, kink-located, tol 1e-10" (for tables, figure legends and study descriptions).
+// The method's label with the settings a reader needs to repeat the run: "PIM", "switching PIM"
+// ("switching PIM, d = 6" for a force degree other than 2), "dopri5, kink-located, tol 1e-10" (for tables, figure legends and study descriptions).
 std::string method_label(const MethodSettings& settings);
 
 // Whether the integrator the settings build ends a step at every spring switch and counts the
 // switches in IntegratorStats::kink_events: a row that always does (locates_switches), or one
 // that can (kink_location) asked to (locate_kinks).
 bool locates_switches(const MethodSettings& settings);
+
+// Whether the row's method takes a force degree d (MethodSettings::force_degree, order d + 3):
+// the switching PIM's rows, the fixed-grid methods that locate every switch.
+inline bool takes_force_degree(const MethodTraits& row) {
+  return row.fixed_grid && row.locates_switches;
+}
 
 // The integrator the settings name, built for `structure`, its state at rest at t = 0. Throws
 // InputError for invalid settings (the message of is_valid) or a structure the method refuses.
