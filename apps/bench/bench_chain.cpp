@@ -96,7 +96,8 @@ const ChainMethodResult* fastest_pwl_row_as_accurate_as(const ChainBenchResult& 
 // The floor at step η and band q (0: from the tolerance): T = exp(Hη) built as the banded
 // steppers build it (make_banded_step_operators, from the period), and the median wall time of
 // one bare T v over 7 repeats of about 10 ms each.
-ChainFloorRow measure_floor(const GapStructure& structure, double t_end, double step, int band) {
+ChainFloorRow measure_floor(const GapStructure& structure, double t_end, double step,
+                            Index band) {
   BandedExponentialOptions options;
   options.band = band;
   const BandedStepOperators ops = make_banded_step_operators(structure, step, options);
@@ -117,7 +118,6 @@ ChainFloorRow measure_floor(const GapStructure& structure, double t_end, double 
   for (int r = 0; r < 7; ++r) per.push_back(products(calls));
   ChainFloorRow row;
   row.step = step;
-  row.band = band;
   row.chosen_band = ops.truncation.band;
   row.width = T.width();
   row.transition_product = median(per);
@@ -126,8 +126,9 @@ ChainFloorRow measure_floor(const GapStructure& structure, double t_end, double 
 }
 
 // Whether a row runs a banded PIM on a fixed grid (its steps each multiply by T once).
-bool banded_fixed_step(const std::string& key) {
-  return key == "pim-banded" || key == "pim-rule" || key == "pim-switching" || key == "pim-rtol";
+bool banded_fixed_step(const MethodSettings& settings) {
+  const MethodTraits& row = method_traits(settings.method);
+  return row.banded && row.fixed_grid;
 }
 
 }  // namespace
@@ -171,6 +172,17 @@ ChainBenchResult run_chain_bench(const ChainBenchOptions& o) {
     if (key == "pim-dense" && o.without_dense) return false;
     return o.methods.empty() || std::find(o.methods.begin(), o.methods.end(), key) != o.methods.end();
   };
+  if (wanted("pim-switching")) {
+    // Checked now, not after the reference and the rows before them.
+    for (double step : o.switching_steps) {
+      const double steps = o.t_end / step;
+      if (std::abs(steps - std::round(steps)) > 1e-9 * steps || std::round(steps) < 1) {
+        throw InputError(fmt::format("bench chain: switching step = {} does not divide t-end = {} "
+                                     "({} steps)",
+                                     step, o.t_end, steps));
+      }
+    }
+  }
   const auto say = [&](const std::string& text) {
     if (!o.quiet) {
       fmt::print("{}\n", text);
@@ -250,7 +262,8 @@ ChainBenchResult run_chain_bench(const ChainBenchOptions& o) {
       request.relative_tolerance = rtol;
       request.period = o.t_end;  // the step divides the run (its end is on the grid)
       request.probe = std::min(o.t_end, 4 * M_PI);  // two periods of the loads (sin 3t, sin 5t)
-      request.force_degrees = {2, 4, 6};            // as `--rtol` chooses (case_options.cpp)
+      request.force_degrees.assign(kChoosableForceDegrees.begin(),  // as `--rtol` chooses
+                                   kChoosableForceDegrees.end());
       MethodSettings settings = fixed_step(Method::pim_switching_banded, 0.0);
       // The step and degree it finds, for the label; the timed runs find them again.
       const AccuracyStep chosen = step_for_accuracy(structure, settings, 0.0, rest, rest, request);
@@ -299,7 +312,7 @@ ChainBenchResult run_chain_bench(const ChainBenchOptions& o) {
     r.parameters = m.parameters;
     r.runs = m.runs;
     r.base = m.base;
-    const int band = m.settings.band;
+    const Index band = m.settings.band;
     std::vector<double> walls, cpus, setups;
     for (int run = 0; run < m.runs; ++run) {
       TrackRecord record;
@@ -329,19 +342,23 @@ ChainBenchResult run_chain_bench(const ChainBenchOptions& o) {
     r.setup = median(setups);
     std::tie(r.error_x, r.error_v) = largest_errors(r.record, result.reference);
     say(fmt::format("  largest error: x1 {:.2e} m, x1' {:.2e} m/s", r.error_x, r.error_v));
-    if (banded_fixed_step(r.key) && r.steps > 0) {
+    if (banded_fixed_step(m.settings) && r.steps > 0) {
       // The row's own floor: its step is what divides the run into its steps.
       const ChainFloorRow floor =
           measure_floor(structure, o.t_end, o.t_end / static_cast<double>(r.steps), band);
       r.floor = floor.floor();
-      say(fmt::format("  floor: {} steps x {:.2f} us (bare T v, q = {}) = {:.3g} s; the run after its "
-                      "set-up is {:.2f} T v per step",
+      say(fmt::format("  floor: {} steps x {:.2f} us (bare T v, q = {}) = {:.3g} s; the run "
+                      "after its set-up is {:.2f} T v per step",
                       floor.steps, 1e6 * floor.transition_product, floor.chosen_band, r.floor,
                       (r.wall - r.setup) / r.floor));
     }
     result.methods.push_back(std::move(r));
   }
   for (double step : o.floor_steps) {
+    if (step > o.t_end) {
+      say(fmt::format("floor at η = {:g} s: longer than the run ({:g} s), left out", step, o.t_end));
+      continue;
+    }
     result.floors.push_back(measure_floor(structure, o.t_end, step, 0));
     const ChainFloorRow& f = result.floors.back();
     say(fmt::format("floor at η = {:g} s: q = {}, T v {:.2f} us, {} steps: {:.3g} s", f.step,
@@ -357,7 +374,9 @@ ChainBenchResult run_chain_bench(const ChainBenchOptions& o) {
                "key,method,parameters,runs,wall_median_s,cpu_median_s,setup_median_s,steps,"
                "work,error_x1,error_v1,time_vs_banded,error_x1_vs_banded,floor_s\n");
     for (const ChainMethodResult& r : result.methods) {
-      fmt::print(f, "{},\"{}\",\"{}\",{},{:.6g},{:.6g},{:.6g},{},{},{:.6e},{:.6e},{:.6g},{:.6g},{:.6g}\n",
+      fmt::print(f,
+                 "{},\"{}\",\"{}\",{},{:.6g},{:.6g},{:.6g},{},{},{:.6e},{:.6e},{:.6g},{:.6g},"
+                 "{:.6g}\n",
                  r.key, r.label, r.parameters, r.runs, r.wall, r.cpu, r.setup, r.steps, r.work,
                  r.error_x, r.error_v, base ? r.wall / base->wall : 0.0,
                  base ? r.error_x / base->error_x : 0.0, r.floor);

@@ -8,7 +8,7 @@
 # and degree found on the run's first 5 s) are within them in x1 and x1' (the motion's size is about 1).
 # The order-7 rows (--switching-degrees 2,4: force degree 4) are at least 100x more accurate than
 # the order-5 rows at η = 0.1 s and at rounding (below 1e-13) at η = 0.02 s. The floor tables list
-# every banded row and each step of --floor-steps with the band the steppers choose there
+# every banded row (with its steps) and each step of --floor-steps with the band the steppers choose there
 # (q = 5 at η = 0.02 s, 8 at 0.2 s, as `cli_bench_scaling_small` finds for the stepper itself).
 # No timing is asserted.
 # Usage: bench_chain_switching.sh PWL OUTPUT_FOLDER
@@ -31,7 +31,11 @@ awk -F'|' '
   $2 ~ /banded switching PIM/ && NF == 13 && $3 ~ /η = 0.02 s, order 5/ { fine_x = $9 + 0; fine_v = $10 + 0; n++ }
   $2 ~ /banded switching PIM/ && NF == 13 && $3 ~ /η = 0.1 s, order 7/ { coarse7_x = $9 + 0; coarse7_v = $10 + 0; n7++ }
   $2 ~ /banded switching PIM/ && NF == 13 && $3 ~ /η = 0.02 s, order 7/ { fine7_x = $9 + 0; fine7_v = $10 + 0; n7++ }
-  $2 == " banded switching PIM " && NF == 7 && $5 + 0 > 0 && $6 + 0 > 0 { floors++ }
+  NF == 13 && $2 ~ /banded switching PIM/ { steps[$3] = $8 + 0 }
+  NF == 7 && $2 ~ /banded switching PIM/ && $5 + 0 > 0 && $6 + 0 > 0 {
+    floors++
+    if (steps[$3] != $4 + 0) { print "floor row" $3 "has " $4 " steps, its row " steps[$3]; bad_steps++ }
+  }
   NF == 9 && $2 + 0 == 0.02 { q_fine = $3 + 0; by_step++ }
   NF == 9 && $2 + 0 == 0.2 { q_coarse = $3 + 0; by_step++ }
   $0 ~ /^- dopri5 \(plain, like ode45\) \(rtol = atol = 1e-10\): banded switching PIM/ { named = 1 }
@@ -50,7 +54,8 @@ awk -F'|' '
     printf "order 7: x1 %.2e -> %.2e, x1p %.2e -> %.2e\n", coarse7_x, fine7_x, coarse7_v, fine7_v
     if (!(100 * coarse7_x <= coarse_x && 100 * coarse7_v <= coarse_v)) { print "order 7 is not 100x more accurate than order 5 at 0.1 s"; exit 1 }
     if (!(fine7_x < 1e-13 && fine7_v < 1e-13)) { print "the order-7 row at 0.02 s is not at rounding"; exit 1 }
-    if (floors != 4) { print "expected a floor for each of the 4 switching rows, found " floors; exit 1 }
+    if (floors != 6) { print "expected a floor for each of the 6 switching and --rtol rows, found " floors; exit 1 }
+    if (bad_steps > 0) { print "a floor row counts other steps than its row"; exit 1 }
     if (by_step != 2 || q_fine != 5 || q_coarse != 8) { print "floor by step: " by_step " rows, q " q_fine " and " q_coarse " (expected 5 and 8)"; exit 1 }
     print "switching rows: accurate, order 5, named against dopri5"
   }' "$out/bench_chain.md"

@@ -147,9 +147,43 @@ TEST_CASE("accuracy request: the chosen step meets it against kink-located rkf78
                  << ", chosen d = " << chosen.force_degree << " T/" << chosen.steps_per_period);
     CHECK(chosen.steps_per_period <= alone.steps_per_period);
   }
+  CHECK(cases[2].chosen.force_degree == 4);  // d = 2 missed at d = 6's step, d = 4 met it
+  CHECK(cases[2].chosen.degree_checks == 2);
   CHECK(cases[3].chosen.force_degree == 6);
   CHECK(cases[3].chosen.steps_per_period * 2 <= cases[1].chosen.steps_per_period);
   CHECK(cases[4].chosen.force_degree == 2);
+}
+
+TEST_CASE("accuracy request: the degrees' order and repeats do not matter, one degree is the "
+          "base's",
+          "[accuracy]") {
+  const GapStructure s = varying_chain();
+  const Vector zero = Vector::Zero(s.dofs());
+  MethodSettings m;
+  m.method = Method::pim_switching;
+  AccuracyRequest request;
+  request.relative_tolerance = 1e-5;
+  request.period = 2 * M_PI;
+  request.probe = 2 * M_PI;
+  request.force_degrees = {2, 4, 6};
+  const AccuracyStep sorted = step_for_accuracy(s, m, 0.0, zero, zero, request);
+  request.force_degrees = {6, 2, 6, 4};
+  const AccuracyStep shuffled = step_for_accuracy(s, m, 0.0, zero, zero, request);
+  CHECK(shuffled.steps_per_period == sorted.steps_per_period);
+  CHECK(shuffled.force_degree == sorted.force_degree);
+  CHECK(shuffled.estimated_error == sorted.estimated_error);
+  CHECK(shuffled.degree_checks == sorted.degree_checks);
+  // One degree asked is the base settings at that degree, step for step.
+  request.force_degrees = {4};
+  const AccuracyStep one = step_for_accuracy(s, m, 0.0, zero, zero, request);
+  request.force_degrees.clear();
+  m.force_degree = 4;
+  const AccuracyStep base = step_for_accuracy(s, m, 0.0, zero, zero, request);
+  CHECK(one.steps_per_period == base.steps_per_period);
+  CHECK(one.estimated_error == base.estimated_error);
+  CHECK(one.force_degree == 4);
+  CHECK(base.force_degree == 4);
+  CHECK(one.degree_checks == 0);
 }
 
 TEST_CASE("accuracy request: bad requests are refused by name", "[accuracy]") {
@@ -192,6 +226,12 @@ TEST_CASE("accuracy request: bad requests are refused by name", "[accuracy]") {
   CHECK_THAT(message(m, bad), Catch::Contains("relative tolerance = 1e-10: pim-switching does not "
                                               "reach it on this structure within 20 steps"));
   bad = r;
+  bad.relative_tolerance = 1e-10;
+  bad.max_steps_per_period = 20;
+  bad.force_degrees = {2, 4};
+  CHECK_THAT(message(m, bad), Catch::Contains("force degree 4 (the highest asked): relative "
+                                              "tolerance = 1e-10: pim-switching does not reach"));
+  bad = r;
   bad.force_degrees = {2, 9};
   CHECK_THAT(message(m, bad), Catch::Contains("force_degrees: degree 9 is not in 0 .. 8"));
   bad.force_degrees = {-1};
@@ -200,5 +240,6 @@ TEST_CASE("accuracy request: bad requests are refused by name", "[accuracy]") {
   plain.method = Method::pim;
   bad = r;
   bad.force_degrees = {2, 4};
-  CHECK_THAT(message(plain, bad), Catch::Contains("force_degrees = [2, 4]: pim takes no force degree"));
+  CHECK_THAT(message(plain, bad),
+             Catch::Contains("force_degrees = [2, 4]: pim takes no force degree"));
 }

@@ -156,7 +156,8 @@ void add_case_options(CLI::App& c, CaseOptions& o) {
   c.add_option("--force-degree", o.force_degree,
                "Switching PIM: derivatives d of the spring forces used (order d + 3), 0 .. 8;\n"
                "default 2, or with --rtol chosen with the step from 2, 4 and 6")
-      ->check(number_in(0, 8));
+      ->check(number_in(0, 8))
+      ->default_str("2");
   c.add_option("--tol", o.tolerance, "Relative and absolute tolerance of dopri5/rkf78")
       ->check(positive_number());
   c.add_flag("--locate-kinks", o.locate_kinks,
@@ -220,7 +221,7 @@ NondimensionalChain CaseOptions::chain() const {
 
 int CaseOptions::grid_steps(double period) const {
   if (!(rtol > 0.0)) return steps_per_period;
-  if (rtol_steps > 0) return static_cast<int>(rtol_steps);
+  if (rtol_steps > 0 && rtol_method == method) return static_cast<int>(rtol_steps);
   const Method m = parse_method(method);
   if (!method_traits(m).fixed_grid) {
     throw InputError(fmt::format("--rtol = {}: the accuracy request of the PIM family; {} takes "
@@ -242,7 +243,7 @@ int CaseOptions::grid_steps(double period) const {
     if (force_degree >= 0) {
       settings.force_degree = force_degree;
     } else {
-      request.force_degrees = {2, 4, 6};
+      request.force_degrees.assign(kChoosableForceDegrees.begin(), kChoosableForceDegrees.end());
     }
   }
   std::string why;
@@ -250,12 +251,18 @@ int CaseOptions::grid_steps(double period) const {
   const AccuracyStep chosen = step_for_accuracy(s, settings, 0.0, y.head(n), y.tail(n), request);
   rtol_steps = chosen.steps_per_period;
   rtol_degree = chosen.force_degree;
+  rtol_method = method;
   fmt::print(stderr,
              "pwl: note: --rtol {:g}: η = T/{} = {:.6g}{} (estimated error {:.2g} over the first "
-             "{} periods; {} steps tried)\n",
+             "{} periods; {} step{} tried{})\n",
              rtol, chosen.steps_per_period, chosen.step,
              chosen.force_degree >= 0 ? fmt::format(", force degree {}", chosen.force_degree) : "",
-             chosen.estimated_error, std::min(periods, 4), chosen.candidates);
+             chosen.estimated_error, std::min(periods, 4), chosen.candidates,
+             chosen.candidates > 1 ? "s" : "",
+             chosen.degree_checks > 0
+                 ? fmt::format(", then {} lower degree{} at that step", chosen.degree_checks,
+                               chosen.degree_checks > 1 ? "s" : "")
+                 : "");
   return static_cast<int>(rtol_steps);
 }
 
@@ -306,8 +313,9 @@ analysis::PointModel CaseOptions::model() const {
 MethodSettings CaseOptions::method_settings(double period) const {
   MethodSettings m;
   m.method = parse_method(method);
-  if (method_traits(m.method).fixed_grid || rtol > 0.0) m.step = step(period);  // --rtol: checks the method
+  // The degree first: a --force-degree the method does not take is refused before --rtol searches.
   m.force_degree = switching_degree(period);
+  if (method_traits(m.method).fixed_grid || rtol > 0.0) m.step = step(period);  // --rtol: checks the method
   m.tolerance = tolerance;
   m.locate_kinks = locate_kinks;
   m.max_step = period / 8;

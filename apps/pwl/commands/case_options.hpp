@@ -83,6 +83,7 @@ struct CaseOptions {
   bool force = false;       // --force: run a step the step guard refuses
   mutable long rtol_steps = 0;  // what --rtol chose (0: not yet)
   mutable int rtol_degree = -1;  // and the switching PIM's degree it chose (-1: none)
+  mutable std::string rtol_method;  // the method they were chosen for
 
   // The chain these flags describe (the preset, then each given flag).
   NondimensionalChain chain() const;

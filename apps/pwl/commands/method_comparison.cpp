@@ -48,6 +48,7 @@ ComparisonResult simulate_with_comparison(const CaseOptions& run, const Comparis
   other.method = with.method;
   other.tolerance = with.tolerance;
   other.locate_kinks = with.locate_kinks;
+  other.force_degree = -1;  // --force-degree is the first method's (the other takes its default)
   auto a = run.integrator(structure, period);
   auto b = other.integrator(structure, period);
   // Both land on the first method's grid (its step, or T / steps-per-period for Runge-Kutta).

@@ -73,9 +73,9 @@ OrbitMethod orbit_method(const OrbitFlags& f, const GapStructure& structure, dou
   CaseOptions run = f.run;
   m.chosen = !f.method_given;
   if (m.chosen) {
-    // An accuracy request (--rtol) asks for the switching PIM's step; otherwise the exact solver
-    // where it applies.
-    run.method = run.rtol == 0.0 && structure.dofs() <= kExactDofs &&
+    // An accuracy request (--rtol) or a force degree asks for the switching PIM; otherwise the
+    // exact solver where it applies.
+    run.method = run.rtol == 0.0 && run.force_degree < 0 && structure.dofs() <= kExactDofs &&
                          structure.spring_count() <= kExactSprings
                      ? "exact"
                      : "pim-switching";

@@ -181,14 +181,19 @@ AccuracyStep step_for_accuracy(const GapStructure& structure, const MethodSettin
   degrees.erase(std::unique(degrees.begin(), degrees.end()), degrees.end());
   MethodSettings settings = base;
   settings.force_degree = degrees.front();
-  search_step(structure, settings, degrees.front() + 3, first, t0, x0, v0, request, out);
+  try {
+    search_step(structure, settings, degrees.front() + 3, first, t0, x0, v0, request, out);
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("force degree {} (the highest asked): {}", degrees.front(),
+                                 e.what()));
+  }
   out.force_degree = degrees.front();
   for (std::size_t k = 1; k < degrees.size(); ++k) {
     settings.force_degree = degrees[k];
     double difference = 0.0;
     const double estimate = estimate_error(structure, settings, out.steps_per_period, t0, x0, v0,
                                            request, &difference);
-    ++out.candidates;
+    ++out.degree_checks;
     if (!(estimate <= request.relative_tolerance)) break;
     out.force_degree = degrees[k];
     out.estimated_error = estimate;

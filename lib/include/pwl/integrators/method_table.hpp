@@ -97,7 +97,8 @@ struct MethodSettings {
 };
 
 // The method's label with the settings a reader needs to repeat the run: "PIM", "switching PIM"
-// ("switching PIM, d = 6" for a force degree other than 2), "dopri5, kink-located, tol 1e-10" (for tables, figure legends and study descriptions).
+// ("switching PIM, d = 6" for a force degree other than 2), "dopri5, kink-located, tol 1e-10"
+// (for tables, figure legends and study descriptions).
 std::string method_label(const MethodSettings& settings);
 
 // Whether the integrator the settings build ends a step at every spring switch and counts the
