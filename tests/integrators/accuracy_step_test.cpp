@@ -62,6 +62,15 @@ double relative_error(const std::vector<Vector>& a, const std::vector<Vector>& t
   return std::max(dx / sx, dv / sv);
 }
 
+// A request for `tolerance` over one period of the paper's loads (2π), probed on that period.
+AccuracyRequest one_period_request(double tolerance) {
+  AccuracyRequest r;
+  r.relative_tolerance = tolerance;
+  r.period = 2 * M_PI;
+  r.probe = 2 * M_PI;
+  return r;
+}
+
 }  // namespace
 
 TEST_CASE("accuracy request: the chosen step meets it against kink-located rkf78",
@@ -161,10 +170,7 @@ TEST_CASE("accuracy request: the degrees' order and repeats do not matter, one d
   const Vector zero = Vector::Zero(s.dofs());
   MethodSettings m;
   m.method = Method::pim_switching;
-  AccuracyRequest request;
-  request.relative_tolerance = 1e-5;
-  request.period = 2 * M_PI;
-  request.probe = 2 * M_PI;
+  AccuracyRequest request = one_period_request(1e-5);
   request.force_degrees = {2, 4, 6};
   const AccuracyStep sorted = step_for_accuracy(s, m, 0.0, zero, zero, request);
   request.force_degrees = {6, 2, 6, 4};
@@ -191,10 +197,7 @@ TEST_CASE("accuracy request: bad requests are refused by name", "[accuracy]") {
   const Vector zero = Vector::Zero(s.dofs());
   MethodSettings m;
   m.method = Method::pim_switching;
-  AccuracyRequest r;
-  r.relative_tolerance = 1e-6;
-  r.period = 2 * M_PI;
-  r.probe = 2 * M_PI;
+  const AccuracyRequest r = one_period_request(1e-6);
   const auto message = [&](const MethodSettings& settings, const AccuracyRequest& request) {
     try {
       step_for_accuracy(s, settings, 0.0, zero, zero, request);
