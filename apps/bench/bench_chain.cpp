@@ -7,6 +7,7 @@
 #include <ctime>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 
@@ -304,6 +305,7 @@ ChainBenchResult run_chain_bench(const ChainBenchOptions& o) {
     return make_integrator(structure, settings);
   };
 
+  std::map<std::pair<long, Index>, ChainFloorRow> floors;  // by (steps, forced band)
   for (const BenchRow& m : methods) {
     say(fmt::format("{} ({}): {} run{} ...", m.label, m.parameters, m.runs, m.runs > 1 ? "s" : ""));
     ChainMethodResult r;
@@ -343,9 +345,17 @@ ChainBenchResult run_chain_bench(const ChainBenchOptions& o) {
     std::tie(r.error_x, r.error_v) = largest_errors(r.record, result.reference);
     say(fmt::format("  largest error: x1 {:.2e} m, x1' {:.2e} m/s", r.error_x, r.error_v));
     if (banded_fixed_step(m.settings) && r.steps > 0) {
-      // The row's own floor: its step is what divides the run into its steps.
-      const ChainFloorRow floor =
-          measure_floor(structure, o.t_end, o.t_end / static_cast<double>(r.steps), band);
+      // The row's own floor: its step is what divides the run into its steps. Rows with the same
+      // steps and band (the degrees of one step) share one measurement.
+      auto known = floors.find({r.steps, band});
+      if (known == floors.end()) {
+        known = floors
+                    .emplace(std::pair{r.steps, band},
+                             measure_floor(structure, o.t_end,
+                                           o.t_end / static_cast<double>(r.steps), band))
+                    .first;
+      }
+      const ChainFloorRow& floor = known->second;
       r.floor = floor.floor();
       say(fmt::format("  floor: {} steps x {:.2f} us (bare T v, q = {}) = {:.3g} s; the run "
                       "after its set-up is {:.2f} T v per step",

@@ -169,25 +169,21 @@ AccuracyStep step_for_accuracy(const GapStructure& structure, const MethodSettin
       traits.step_warning > 0.0 && omega > 0.0 ? traits.step_warning / omega : request.period;
   const long first =
       std::max<long>(1, static_cast<long>(std::ceil(request.period / out.largest_step - 1e-9)));
-  if (request.force_degrees.empty()) {
-    const int order = switching ? base.force_degree + 3 : std::max(1, traits.order);
-    search_step(structure, base, order, first, t0, x0, v0, request, out);
-    out.force_degree = switching ? base.force_degree : -1;
-    return out;
-  }
-  // The highest degree finds the step; the lower ones are kept while they meet it there.
+  // With degrees to choose from, the highest finds the step and the lower ones are tried at it.
+  MethodSettings settings = base;
   std::vector<int> degrees = request.force_degrees;
   std::sort(degrees.begin(), degrees.end(), std::greater<>());
   degrees.erase(std::unique(degrees.begin(), degrees.end()), degrees.end());
-  MethodSettings settings = base;
-  settings.force_degree = degrees.front();
+  if (!degrees.empty()) settings.force_degree = degrees.front();
+  const int order = switching ? settings.force_degree + 3 : std::max(1, traits.order);
   try {
-    search_step(structure, settings, degrees.front() + 3, first, t0, x0, v0, request, out);
+    search_step(structure, settings, order, first, t0, x0, v0, request, out);
   } catch (const InputError& e) {
+    if (degrees.empty()) throw;
     throw InputError(fmt::format("force degree {} (the highest asked): {}", degrees.front(),
                                  e.what()));
   }
-  out.force_degree = degrees.front();
+  out.force_degree = switching ? settings.force_degree : -1;
   for (std::size_t k = 1; k < degrees.size(); ++k) {
     settings.force_degree = degrees[k];
     double difference = 0.0;
