@@ -151,6 +151,18 @@ TEST_CASE("scene: bad scenes are refused with file, line and key", "[scene]") {
     CHECK(message_of([&] { parse_scene(value, "c.toml"); }).find("is missing") !=
           std::string::npos);
   }
+  // A date-like value, a space, one digit and the value's end: toml++ 3.3 asserts (the fuzzer's
+  // find: oas=  10`0-1E-e" 0 = '''a). A date and time, a longer value and a digit at the end of
+  // the text are left to the library.
+  for (const char* value : {"m = 1979-05-27 1\n", "m = [1979-05-27 1]\n", "m = 1_979-05-27 1,\n",
+                            "oas=  10`0-1E-e\" 0 = '''a\n"}) {
+    CHECK(message_of([&] { parse_scene(value, "c.toml"); })
+              .find("a date followed by a lone digit") != std::string::npos);
+  }
+  for (const char* value : {"m = 1979-05-27 12\n", "m = 1979-05-27 1", "m = 11979-05-27 1\n"}) {
+    CHECK(message_of([&] { parse_scene(value, "c.toml"); })
+              .find("a date followed by a lone digit") == std::string::npos);
+  }
   // Arrays that start a line are values, not headers.
   CHECK(parse_scene("[structure]\nmass = [\n[1.0, 0.0],\n  [0.0, 1.0]]\n", "c.toml")
             .explicit_structure);

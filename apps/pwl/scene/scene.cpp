@@ -4,6 +4,7 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -206,6 +207,23 @@ std::string screen_scene_text(std::string_view text, const std::string& name) {
     return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
            c == '-' || c == '"' || c == '\'';
   };
+  // toml++ 3.3 reads a value of ten characters shaped like a date ("dddd-dd-dd", underscores not
+  // counted) followed by a space as a date and time, and asserts instead of reporting when one
+  // digit and the value's end follow the space ("m = 1979-05-27 1").
+  const auto value_end = [](char c) {
+    return std::string_view(" \t\r\n]},#").find(c) != std::string_view::npos;
+  };
+  const auto lone_time_digit = [&](std::size_t at) {
+    std::array<char, 10> chars{};
+    std::size_t count = 0, j = at;
+    for (; j < text.size() && !value_end(text[j]); ++j) {
+      if (text[j] == '_') continue;
+      if (count == chars.size()) return false;
+      chars[count++] = text[j];
+    }
+    return count == chars.size() && chars[4] == '-' && chars[7] == '-' && j + 2 < text.size() &&
+           text[j] == ' ' && text[j + 1] >= '0' && text[j + 1] <= '9' && value_end(text[j + 2]);
+  };
   while (i < text.size()) {
     const char c = text[i];
     const auto byte = static_cast<unsigned char>(c);
@@ -235,6 +253,11 @@ std::string screen_scene_text(std::string_view text, const std::string& name) {
                                                                      : "a value is missing");
         }
         expect = Expect::nothing;
+      }
+      const bool starts_value =
+          i == 0 || value_end(text[i - 1]) || text[i - 1] == '=' || text[i - 1] == '[';
+      if (c >= '0' && c <= '9' && starts_value && lone_time_digit(i)) {
+        fail("a date followed by a lone digit is not a value");
       }
     }
     switch (state) {

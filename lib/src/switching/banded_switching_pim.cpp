@@ -25,6 +25,7 @@
 #include "numerics/row_blocks.hpp"
 #include "banded/ordered_springs.hpp"
 #include "banded/periodic_cut.hpp"
+#include "switching/local_gap_screen.hpp"
 #include "switching/local_switch_correction.hpp"
 #include "switching/switching_pim_detail.hpp"
 
@@ -194,9 +195,11 @@ struct LoadTerm {
 
 class BandedStepper final : public SwitchingPim,
                             private switching_detail::ModeSeries<BandedStepper, Vector, Vector>,
-                            private switching_detail::LocalSwitchCorrection<BandedStepper> {
+                            private switching_detail::LocalSwitchCorrection<BandedStepper>,
+                            private switching_detail::LocalGapScreen<BandedStepper> {
   friend switching_detail::ModeSeries<BandedStepper, Vector, Vector>;
   friend switching_detail::LocalSwitchCorrection<BandedStepper>;
+  friend switching_detail::LocalGapScreen<BandedStepper>;
   using TangentOp = switching_detail::ModeSeries<BandedStepper, Vector, Vector>::TangentOp;
   using RowSparseMatrix = RowSparse;
   static constexpr const char* kMethodName = "pim-switching-banded";
@@ -656,9 +659,12 @@ class BandedStepper final : public SwitchingPim,
     taylor(t, eta_, d_ + 1, 0.0, false);
     if (o_.locate_switches && screen_fails()) {
       ++diagnostics_.screened;
-      lcp_synced_ = false;
-      switching(t);
-      return;
+      if (!this->gap_screen_clears(t)) {
+        lcp_synced_ = false;
+        switching(t);
+        return;
+      }
+      ++diagnostics_.cleared;
     }
     transition_.multiply(state_.data(), bar_.data());
     for (std::size_t g = 0; g < harmonics_.size(); ++g) {

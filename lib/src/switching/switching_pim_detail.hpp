@@ -497,15 +497,19 @@ class ModeSeries {
   // e(σ) >= e_0 + e_1 σ - S σ² with S the sum of |e_r| for r >= 2; that concave lower bound is
   // positive on [0, 1] when it is positive at both ends.
   bool screen_fails() const {
-    const Stepper& st = self();
-    for (Index j = 0; j < st.m_; ++j) {
-      const double e0 = st.signs_[j] * (gw_[0][j] - st.gaps_[j]);
-      const double e1 = st.signs_[j] * gw_[1][j];
-      double rest = 0.0;
-      for (int r = 2; r <= st.d_ + 1; ++r) rest += std::abs(gw_[static_cast<std::size_t>(r)][j]);
-      if (!(e0 > 0.0 && e0 + e1 - rest > 0.0)) return true;
+    for (Index j = 0; j < self().m_; ++j) {
+      if (!screen_clears(j)) return true;
     }
     return false;
+  }
+  // The same bound for spring j alone.
+  bool screen_clears(Index j) const {
+    const Stepper& st = self();
+    const double e0 = st.signs_[j] * (gw_[0][j] - st.gaps_[j]);
+    const double e1 = st.signs_[j] * gw_[1][j];
+    double rest = 0.0;
+    for (int r = 2; r <= st.d_ + 1; ++r) rest += std::abs(gw_[static_cast<std::size_t>(r)][j]);
+    return e0 > 0.0 && e0 + e1 - rest > 0.0;
   }
 
   // The gap polynomial of the coefficients gw_[0..R] (mode-signed) on σ in [0, 1]; settles the

@@ -139,7 +139,8 @@ struct SwitchingPimDiagnostics {
   long halved_pieces = 0;    // pieces of switching steps halved for their series to converge
   long pieces = 0;           // pieces of those steps
   long switches = 0;         // located spring switches
-  long screened = 0;         // steps the gap screen sent to the series (a possible switch)
+  long screened = 0;         // steps the gap screen could not clear (a possible switch)
+  long cleared = 0;          // of those, kept smooth by the windowed gap series (banded stepper)
   long lcp_mismatches = 0;   // switching steps found by the LCP rather than the screen
   long gap_samples = 0;      // evaluations of the gap polynomials by the root search
   double step_argument = 0;  // η ω_max
