@@ -142,13 +142,15 @@ TEST_CASE("banded switching PIM: error against kink-located rkf78 far below the 
 
 TEST_CASE("banded switching PIM: the windowed gap screen keeps steps without a switch smooth",
           "[banded][switching]") {
-  // At η = 0.8 s the first screen (degree d + 1) sends most steps of the paper's chain to the
-  // switching path, and most of those find no switch. The second screen (local_gap_screen.hpp)
+  // At η = 0.8 s the first screen (degree d + 1) sends most steps of these chains to the
+  // switching path, and many of those find no switch. The second screen (local_gap_screen.hpp)
   // expands the gaps of the springs it left to rounding on windows of rows and keeps such steps
   // smooth. Truth: kink-located rkf78. A step it kept smooth wrongly would either end in an LCP
   // whose contacts differ from the mode (counted) or miss a switch in and out (the error).
-  // Both chains are long enough for the windows (a window costs a quarter of the rows at most);
-  // the second has cells that all differ (the operators row by row).
+  // The paper's chain switches near its ends only (windows cut by an end of the chain); the
+  // second has cells that all differ (operators row by row); the third switches in its middle
+  // only, every other gap out of reach (windows open on both sides). A window costs a quarter of
+  // the rows at most, so the chains are a few hundred masses long.
   ChainParameters varied = paper_large_chain(300);
   varied.mass.assign(300, 1.0);
   varied.gap.assign(300, 0.0);
@@ -156,7 +158,10 @@ TEST_CASE("banded switching PIM: the windowed gap screen keeps steps without a s
     varied.mass[static_cast<std::size_t>(i)] = 1.0 + 0.3 * std::abs(std::sin(0.7 * i));
     varied.gap[static_cast<std::size_t>(i)] = 0.05 * std::cos(1.3 * i);
   }
-  for (const ChainParameters& p : {paper_large_chain(300), varied}) {
+  ChainParameters middle = paper_large_chain(600);
+  middle.gap.assign(600, 5.0);
+  for (int i = 290; i < 310; ++i) middle.gap[static_cast<std::size_t>(i)] = 0.02 * (i % 3);
+  for (const ChainParameters& p : {paper_large_chain(300), varied, middle}) {
     const GapStructure s = make_chain(p);
     const double eta = 0.8;
     const int steps = 75;
@@ -177,12 +182,12 @@ TEST_CASE("banded switching PIM: the windowed gap screen keeps steps without a s
       before = now;
     }
     const SwitchingPimDiagnostics d = pim->diagnostics();
-    INFO("screened " << d.screened << ", cleared " << d.cleared << ", switching steps "
-                     << d.switching_steps << " (" << without_switch << " without a switch), switches "
-                     << d.switches << ", LCP mismatches " << d.lcp_mismatches << ", error " << worst);
-    CHECK(d.switches > 50);
+    INFO("masses " << s.dofs() << ": screened " << d.screened << ", cleared " << d.cleared
+                   << ", switching steps " << d.switching_steps << " (" << without_switch
+                   << " without a switch), switches " << d.switches << ", LCP mismatches "
+                   << d.lcp_mismatches << ", error " << worst);
+    CHECK(d.switches > 30);
     CHECK(d.cleared > 0);
-    CHECK(d.screened == d.cleared + d.switching_steps);
     // Most steps the first screen could not clear and that hold no switch are kept smooth.
     CHECK(d.cleared >= 2 * without_switch);
     CHECK(d.lcp_mismatches == 0);

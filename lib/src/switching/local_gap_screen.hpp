@@ -12,7 +12,9 @@
 // the same search for a first crossing and for springs on their kinks as the switching step
 // would run on them. No crossing: the step stays smooth (its formula is the one every other step
 // uses); a crossing, a spring on its kink, or a window that is not cheaper than the whole state
-// leave the step to the switching path, which decides as before.
+// leave the step to the switching path, which decides as before. The springs the first screen
+// cleared are trusted here as in every smooth step (the switching path searches every spring on
+// the full series, so a flagged step used to look at them again).
 //
 // The window is exact, not an approximation: the r-th Taylor term couples rows at most r · reach
 // apart (K, C and the springs' two ends), so the terms up to K of a spring's rows are those of
@@ -22,14 +24,13 @@
 // the screens' series down to 4 terms more than they need (one less per screen); a series that
 // needs more than K sends its step to the switching path and puts K back to max_series_terms.
 // The series stops as the whole state's does, once two consecutive terms are below ε/2 of the
-// largest, measured on the rows computed for them (all the rows later terms of the spring's rows
-// draw on). The finite reach of each term is what makes banded exponentials of chains possible
+// largest, measured on the rows computed for them (all the rows the spring's later terms up to K
+// draw on): a stopping rule of the same kind as the whole state's, not a bound. The finite reach of each term is what makes banded exponentials of chains possible
 // in the first place (He, Gao & Zhong, Appl. Math. Mech. 39(7) (2018) 737-749); the screen itself
 // is the polynomial root exclusion of event_location.hpp on the gap's series.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
-#include <limits>
 #include <vector>
 
 #include "event/event_location.hpp"
@@ -54,7 +55,7 @@ class LocalGapScreen {
     Stepper& st = static_cast<Stepper&>(*this);
     // The windows' margin K (above).
     const int most = st.o_.max_series_terms;
-    const int K = std::min(most, window_terms_);
+    const int K = window_terms_ > 0 ? std::min(most, window_terms_) : most;
     const Index margin = static_cast<Index>(K) * st.reach_;
     screen_springs_.clear();
     screen_ranges_.clear();
@@ -79,12 +80,12 @@ class LocalGapScreen {
     for (const RowRanges::Range& range : screen_ranges_.ranges()) {
       const int terms = window_series(st, t, range.first, range.second, K);
       if (terms < 0) {
-        window_terms_ = most;
+        window_terms_ = 0;
         return false;
       }
       longest = std::max(longest, terms);
     }
-    window_terms_ = std::max(longest + 4, window_terms_ - 1);
+    window_terms_ = std::max(longest + 4, K - 1);
 
     // The polynomials of the screened springs, mode-signed, and the switching step's search on
     // them: settled kinks first, then a first crossing on [0, 1].
@@ -217,7 +218,7 @@ class LocalGapScreen {
     return -1;
   }
 
-  int window_terms_ = std::numeric_limits<int>::max();
+  int window_terms_ = 0;  // the windows' K; 0: max_series_terms
   std::vector<Index> screen_springs_;  // the springs the first screen left, ascending
   std::vector<std::size_t> window_springs_;  // those of one window (entries of screen_springs_)
   RowRanges screen_ranges_;            // their windows
