@@ -616,16 +616,19 @@ class BandedStepper final : public SwitchingPim,
     damping_band_.multiply_add(u.data(), acc.data());
     if (forces) force_band_.multiply_add(p.data(), acc.data());
   }
-  // (W^T x)_j: spring j's stretch in the displacement x, from its sparse row.
-  double spring_stretch(Index j, const Vector& x) const {
+  // (W^T x)_j: spring j's stretch in the displacement x, from its sparse row. x is read by row
+  // index: a whole-state Vector, or a window's rows (local_gap_screen.hpp).
+  template <class Rows>
+  double spring_stretch(Index j, const Rows& x) const {
     double g = 0.0;
     for (RowSparse::InnerIterator it(gap_rows_, j); it; ++it) g += it.value() * x[it.col()];
     return g;
   }
   // Row i of -M⁻¹ (K x + C u + W p) from the sparse rows, p_j = force_of(j): the windowed series
-  // (the local switch corrections', the smooth steps' tangent recursion) row by row.
-  template <class ForceOf>
-  double row_acceleration(Index i, const Vector& x, const Vector& u, ForceOf&& force_of) const {
+  // (the local switch corrections', the smooth steps' tangent recursion, the second gap screen's)
+  // row by row; x and u as for spring_stretch.
+  template <class Rows, class ForceOf>
+  double row_acceleration(Index i, const Rows& x, const Rows& u, ForceOf&& force_of) const {
     double acc = 0.0;
     for (RowSparse::InnerIterator it(stiffness_part_, i); it; ++it) acc += it.value() * x[it.col()];
     for (RowSparse::InnerIterator it(damping_part_, i); it; ++it) acc += it.value() * u[it.col()];

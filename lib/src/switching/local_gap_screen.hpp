@@ -40,10 +40,17 @@
 
 namespace pwl::switching_detail {
 
+// A window's rows of one term (row `lo` first), read by the structure's row index.
+struct WindowRows {
+  const double* values;
+  Index lo;
+  double operator[](Index row) const { return values[row - lo]; }
+};
+
 // CRTP mixin of the banded switching stepper (a friend of it, whose ModeSeries buffers and search
 // it uses): the stepper provides reach_, n_, m_, eta_, o_, mode_, signs_, gaps_, stiffnesses_,
-// spring_offset_, loads_, the sparse rows stiffness_part_, damping_part_, force_part_ (row-major)
-// and gap_rows_, the series start xs_[0], us_[0] and the first screen's terms.
+// spring_offset_, loads_, gap_rows_, the row sums row_acceleration and spring_stretch (read
+// through WindowRows), the series start xs_[0], us_[0] and the first screen's terms.
 template <class Stepper>
 class LocalGapScreen {
  protected:
@@ -147,12 +154,10 @@ class LocalGapScreen {
       if (it.col() >= lo && it.col() < hi) window_springs_.push_back(k);
     }
     auto record_gaps = [&](int r, const double* xr) {
+      const WindowRows rows{xr, lo};
       for (std::size_t k : window_springs_) {
-        double g = 0.0;
-        for (typename Stepper::RowSparseMatrix::InnerIterator it(st.gap_rows_, screen_springs_[k]); it; ++it) {
-          g += it.value() * xr[it.col() - lo];
-        }
-        screen_coefficients_[k * static_cast<std::size_t>(K + 1) + static_cast<std::size_t>(r)] = g;
+        screen_coefficients_[k * static_cast<std::size_t>(K + 1) + static_cast<std::size_t>(r)] =
+            st.spring_stretch(screen_springs_[k], rows);
       }
     };
     auto size_of = [&](int r, const double* xr, const double* ur) {
@@ -168,39 +173,23 @@ class LocalGapScreen {
     for (int r = 0; r < K; ++r) {
       const double f = st.eta_ / (r + 1);
       for (std::size_t g = 0; g < groups; ++g) {
-        // d^r/dt^r of sin and cos at ωt, scaled by (ωη)^r / r!: the cycle (S, C, -S, -C).
-        const double S = load_sin_[g], C = load_cos_[g];
-        switch (r % 4) {
-          case 0: load_ds_[g] = S; load_dc_[g] = C; break;
-          case 1: load_ds_[g] = C; load_dc_[g] = -S; break;
-          case 2: load_ds_[g] = -S; load_dc_[g] = -C; break;
-          default: load_ds_[g] = -C; load_dc_[g] = S; break;
-        }
+        // d^r/dt^r of sin and cos at ωt, scaled by (ωη)^r / r!.
+        harmonic_derivative(r, load_sin_[g], load_cos_[g], load_ds_[g], load_dc_[g]);
         load_ds_[g] *= load_scale_[g];
         load_dc_[g] *= load_scale_[g];
         load_scale_[g] *= st.loads_[g].omega * st.eta_ / (r + 1);
       }
       const Index from = first_row(r + 1), to = last_row(r + 1);
+      const WindowRows xr{x, lo}, ur{u, lo};
+      // The forces of the springs touching in the current mode (the offset in the first term).
+      const auto force_of = [&](Index j) {
+        if (!(st.mode_[j] > 0.0)) return 0.0;
+        const double force = st.stiffnesses_[j] * st.spring_stretch(j, xr);
+        return r == 0 ? force - st.spring_offset_[j] : force;
+      };
       for (Index i = from; i < to; ++i) {
         const Index row = lo + i;
-        double acc = 0.0;
-        for (typename Stepper::RowSparseMatrix::InnerIterator it(st.stiffness_part_, row); it; ++it) {
-          acc += it.value() * x[it.col() - lo];
-        }
-        for (typename Stepper::RowSparseMatrix::InnerIterator it(st.damping_part_, row); it; ++it) {
-          acc += it.value() * u[it.col() - lo];
-        }
-        for (typename Stepper::RowSparseMatrix::InnerIterator it(st.force_part_, row); it; ++it) {
-          const Index j = it.col();
-          if (!(st.mode_[j] > 0.0)) continue;
-          double stretch = 0.0;
-          for (typename Stepper::RowSparseMatrix::InnerIterator w(st.gap_rows_, j); w; ++w) {
-            stretch += w.value() * x[w.col() - lo];
-          }
-          double force = st.stiffnesses_[j] * stretch;
-          if (r == 0) force -= st.spring_offset_[j];
-          acc += it.value() * force;
-        }
+        double acc = st.row_acceleration(row, xr, ur, force_of);
         for (std::size_t g = 0; g < groups; ++g) {
           acc += load_ds_[g] * st.loads_[g].sin_part[row] + load_dc_[g] * st.loads_[g].cos_part[row];
         }

@@ -129,6 +129,17 @@ class PolynomialGaps final : public event_detail::ModeGaps {
   }
 };
 
+// The r-th derivative of (sin ωt, cos ωt) over ω^r, from S = sin ωt and C = cos ωt: the cycle
+// (S, C, -S, -C) for sin, into ds and dc.
+inline void harmonic_derivative(int r, double S, double C, double& ds, double& dc) {
+  switch (r % 4) {
+    case 0: ds = S; dc = C; break;
+    case 1: ds = C; dc = -S; break;
+    case 2: ds = -S; dc = -C; break;
+    default: ds = -C; dc = S; break;
+  }
+}
+
 // The springs of a set of gap polynomials (PolynomialGaps, σ in [0, 1]) that can reach their
 // kink on the piece, with their polynomials, search settings and samples at σ = 0, for a search
 // that need not look at the others. Left out: the springs whose mode-signed gap
@@ -455,15 +466,9 @@ class ModeSeries {
       if (!full && r + 1 == last) break;  // the last velocity term is not needed
       st.acceleration(xs_[ru], us_[ru], ps_[ru], acc_);
       for (std::size_t g = 0; g < st.loads_.size(); ++g) {
-        // d^r/dt^r of sin and cos at ωt, scaled by (ωh)^r / r!: the cycle (S, C, -S, -C).
-        const double S = phase_sin_[g], C = phase_cos_[g];
+        // d^r/dt^r of sin and cos at ωt, scaled by (ωh)^r / r!.
         double ds = 0.0, dc = 0.0;
-        switch (r % 4) {
-          case 0: ds = S; dc = C; break;
-          case 1: ds = C; dc = -S; break;
-          case 2: ds = -S; dc = -C; break;
-          default: ds = -C; dc = S; break;
-        }
+        harmonic_derivative(r, phase_sin_[g], phase_cos_[g], ds, dc);
         const double scale = load_scale_[g];
         if (scale != 0.0) acc_ += scale * (ds * st.loads_[g].sin_part + dc * st.loads_[g].cos_part);
         load_scale_[g] = scale * st.loads_[g].omega * h / (r + 1);
