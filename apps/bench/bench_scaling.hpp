@@ -26,6 +26,7 @@ struct ScalingRow {
   double setup_seconds = 0.0;   // operators and propagator
   double step_us = 0.0;         // median time of one step (x, x' and the LCP), microseconds
   double transition_us = 0.0;   // the bare product T v alone
+  double step_per_product = 0.0;  // median over repeats of (step) / (T v), each within a repeat
   double products_us = 0.0;     // T v + Ψ P + Φ P: the products one step makes
   double operator_mb = 0.0;     // memory held by the stepper's operators and vectors
   long stored_rows = 0;         // distinct rows of T stored

@@ -81,6 +81,15 @@ TEST_CASE("Banded products equal dense products for fixed and run-time widths", 
       CHECK((product - A * x).cwiseAbs().maxCoeff() <= 1e-13 * (1 + cols));
       CHECK((y - y0 - A * x).cwiseAbs().maxCoeff() <= 1e-13 * (1 + cols));
     }
+    // The listed rows only, in any order and with repeats, as the LCP's sweeps ask for them.
+    std::vector<int> listed;
+    for (Index i = rows - 1; i >= 0; i -= 3) listed.push_back(static_cast<int>(i));
+    if (rows > 0) listed.push_back(0);
+    std::vector<double> some(listed.size(), 99.0);
+    B.multiply_listed_rows(x.data(), listed.data(), static_cast<Index>(listed.size()), some.data());
+    for (std::size_t c = 0; c < listed.size(); ++c) {
+      CHECK(std::abs(some[c] - A.row(listed[c]).dot(x)) <= 1e-13 * (1 + cols));
+    }
   }
   CHECK_THROWS_AS(BandedMatrix::from_dense(Matrix::Identity(3, 3), 1) * Vector::Ones(4),
                   InputError);

@@ -170,6 +170,38 @@ RowKernel row_kernel(Index width) {
                                              : table[0];
 }
 
+// Listed rows: out[c] = a_{rows[c]} · x[first ..], the width fixed at compile time as above.
+using ListedKernel = void (*)(const BandedMatrix&, const double*, const int*, Index, double*);
+
+void generic_listed_rows(const BandedMatrix& A, const double* x, const int* rows, Index count,
+                         double* out) {
+  for (Index c = 0; c < count; ++c) {
+    out[c] = dot(A.row_values(rows[c]), x + A.first_column(rows[c]), A.width());
+  }
+}
+
+template <int W>
+void fixed_listed_rows(const BandedMatrix& A, const double* x, const int* rows, Index count,
+                       double* out) {
+  using Row = Eigen::Matrix<double, W, 1>;
+  for (Index c = 0; c < count; ++c) {
+    out[c] = Eigen::Map<const Row>(A.row_values(rows[c]))
+                 .dot(Eigen::Map<const Row>(x + A.first_column(rows[c])));
+  }
+}
+
+template <int... Ws>
+constexpr std::array<ListedKernel, sizeof...(Ws) + 1> listed_table(
+    std::integer_sequence<int, Ws...>) {
+  return {&generic_listed_rows, &fixed_listed_rows<Ws + 1>...};
+}
+
+ListedKernel listed_kernel(Index width) {
+  static constexpr auto table = listed_table(std::make_integer_sequence<int, kFixedWidths>{});
+  return width >= 1 && width <= kFixedWidths ? table[static_cast<std::size_t>(width)]
+                                             : table[0];
+}
+
 void check_range(Index r0, Index r1, Index rows) {
   if (r0 < 0 || r1 > rows || r0 > r1) {
     throw InputError(fmt::format("banded product: rows [{}, {}) outside 0..{}", r0, r1, rows));
@@ -253,6 +285,15 @@ void BandedMatrix::multiply_add(const double* x, double* y, Index row_begin,
   if (width_ == 0) return;
   const RowKernel kernel = row_kernel<true>(width_);
   over_row_blocks(row_begin, row_end, [&](Index b, Index e) { kernel(*this, x, y, b, e); });
+}
+
+void BandedMatrix::multiply_listed_rows(const double* x, const int* rows, Index count,
+                                        double* out) const {
+  if (width_ == 0) {
+    std::fill(out, out + count, 0.0);
+    return;
+  }
+  listed_kernel(width_)(*this, x, rows, count, out);
 }
 
 void BandedMatrix::transpose_multiply_add(const double* x, double* y) const {

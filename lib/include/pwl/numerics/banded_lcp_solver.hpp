@@ -14,15 +14,17 @@
 //
 //  - When M is strictly diagonally dominant (every row's off-diagonal sum at most
 //    dominance_limit times its diagonal, true of the step's matrix I + O(η²)), so is every M_AA,
-//    and Gauss-Seidel sweeps over A converge with rate at most that ratio: a handful of sweeps
-//    reach rounding, each O(|A| · width), started from the previous step's forces.
+//    and Jacobi sweeps over A converge with rate at most that ratio: a handful of sweeps reach
+//    rounding, each O(|A| · width), started from the previous step's forces. (Jacobi rather
+//    than Gauss-Seidel: its rows are independent, so a sweep runs at the speed of a product.)
 //  - Otherwise M_AA is factorised without pivoting (a P-matrix has positive leading principal
 //    minors, so every pivot is positive; a pivot that is not means M is not a P-matrix and is
 //    reported). The factors of the previous active set are kept, and a new set refactorises only
 //    from its first index that differs.
 //
-// The slacks w = q + M z are accumulated from the columns of the active set only, so an
-// iteration costs O(m) simple operations plus O(|A| · width). From one step to the next almost
+// The stepper's path (solve_forces) forms only the slacks that can be negative: the rows of M
+// within the band of an active index, and those with q_i < 0, each one row of M against z, so
+// an iteration costs O(m) simple operations plus O(|A| · width). From one step to the next almost
 // every spring keeps its state, so the warm start is usually already the answer, or one block
 // pivot away.
 #include <string>
@@ -34,7 +36,7 @@
 namespace pwl {
 
 struct BandedLcpOptions {
-  // Iterate (Gauss-Seidel) when max_i Σ_{j≠i} |M_ij| / M_ii <= dominance_limit; factorise
+  // Iterate (Jacobi sweeps) when max_i Σ_{j≠i} |M_ij| / M_ii <= dominance_limit; factorise
   // otherwise. Must be in [0, 1).
   double dominance_limit = 0.5;
   int max_sweeps = 200;  // per active set, before falling back to the factorisation
@@ -65,22 +67,22 @@ class BandedLcpSolver final : public LcpSolver {
   // The active set after the last solve (ascending indices).
   const std::vector<int>& active_set() const { return set_; }
 
-  // Whether active-set systems are solved by Gauss-Seidel (M diagonally dominant enough).
+  // Whether active-set systems are solved by Jacobi sweeps (M diagonally dominant enough).
   bool iterates() const { return iterate_; }
   // max_i Σ_{j≠i} |M_ij| / M_ii (infinity when a diagonal entry is not positive).
   double dominance() const { return dominance_; }
-  long sweeps() const { return sweeps_; }                  // Gauss-Seidel sweeps so far
+  long sweeps() const { return sweeps_; }                  // Jacobi sweeps so far
   long factorized_rows() const { return factorized_rows_; }  // rows eliminated so far
 
  private:
   void solve_active(const Eigen::Ref<const Vector>& q, double* z);
   void rebuild_set();
-  bool gauss_seidel(const Eigen::Ref<const Vector>& q, double* z);
+  bool jacobi_sweeps(const Eigen::Ref<const Vector>& q, double* z);
   void factorize_and_solve(const Eigen::Ref<const Vector>& q, double* z);
 
   BandedLcpOptions options_;
   BandedMatrix M_;
-  BandedMatrix columns_;          // M^T: w = q + M z from the columns of the active set
+  BandedMatrix columns_;          // M^T: solve()'s w = q + M z from the columns of z
   bool has_matrix_ = false;
   bool iterate_ = false;
   double dominance_ = 0.0;
@@ -90,16 +92,17 @@ class BandedLcpSolver final : public LcpSolver {
   long sweeps_ = 0;
   long factorized_rows_ = 0;
   Vector diagonal_;
+  Vector inverse_diagonal_;       // 1 / M_ii (Jacobi sweeps)
   std::vector<unsigned char> active_;
   std::vector<int> set_;          // the active indices, ascending
   std::vector<int> factored_;     // the active set the factors in lu_ belong to
   std::vector<double> lu_;        // band LU of M_AA, (lower + upper + 1) per row
   std::vector<double> rhs_;
+  std::vector<double> next_;      // row products: a sweep's new forces, or candidates' slacks
   Vector x_;                      // complementary basic vector
-  // solve_forces: candidates (q_i < 0), M z on the band of the active set, flips.
+  // solve_forces: q_i < 0, flips, and the rows whose slack can be negative (also the scratch
+  // of the merged active set).
   std::vector<int> negative_, touched_, flips_;
-  std::vector<double> scratch_;   // zero outside the touched entries
-  std::vector<unsigned char> seen_;
 };
 
 // Whether a banded M is a P-matrix by sufficient tests (as is_p_matrix of lcp_solver.hpp does

@@ -64,6 +64,9 @@ class BandedMatrix {
   // The same for rows [row_begin, row_end) only (a tile of a longer sweep).
   void multiply(const double* x, double* y, Index row_begin, Index row_end) const;
   void multiply_add(const double* x, double* y, Index row_begin, Index row_end) const;
+  // out[c] = (A x)_{rows[c]} for the listed rows only, c < count: O(count · width) (the active
+  // springs of an LCP, and the slacks that can turn negative). out has count entries.
+  void multiply_listed_rows(const double* x, const int* rows, Index count, double* out) const;
   // y += A^T x, row by row, skipping the rows where x is zero: with A = B^T stored by rows, this
   // is y += B x in work proportional to the non-zeros of x (few springs in contact at a time).
   // x has rows() entries, y cols().

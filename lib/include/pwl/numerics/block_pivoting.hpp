@@ -5,7 +5,7 @@
 //
 //  - dense, with the inverse of each principal block cached by active set (lcp_solver.cpp), or
 //    one LU factorisation kept for the last set (large problems, same file);
-//  - banded, by Gauss-Seidel or a band LU of the active set (banded_lcp_solver.cpp);
+//  - banded, by Jacobi sweeps or a band LU of the active set (banded_lcp_solver.cpp);
 //  - fixed-size and inline, inside the 5-DOF stepper (precise_propagator.hpp) and the switching
 //    PIM's smooth step (switching_pim.cpp), with a transform per active set.
 //
