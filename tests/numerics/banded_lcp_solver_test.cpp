@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
 #include <random>
 
 #include "pwl/numerics/banded_lcp_solver.hpp"
@@ -132,6 +133,84 @@ TEST_CASE("Warm starts from the previous solution take few pivots", "[banded][lc
     CHECK(warm_pivots * 4 < cold_pivots);
     CHECK(stepper_pivots == warm_pivots);
   }
+}
+
+TEST_CASE("The stepper's LCP finds every negative slack whatever the band's shape",
+          "[banded][lcp]") {
+  // solve_forces forms only the slacks that can be negative: rows j - upper .. j + lower of
+  // each active j, and the q_i < 0 elsewhere. Bands with lower != upper (one of them 0),
+  // contacts at both ends, and a contact that starts far from any other after the first solve,
+  // on both of the solver's paths (sweeps and band LU), against the dense solver.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const Index n = 40;
+  for (auto [lower, upper] : std::vector<std::array<Index, 2>>{{4, 0}, {0, 4}, {1, 5}, {5, 1}}) {
+    for (int path = 0; path < 2; ++path) {
+      Matrix M = Matrix::Zero(n, n);
+      for (Index i = 0; i < n; ++i) {
+        for (Index j = std::max<Index>(0, i - lower); j <= std::min(n - 1, i + upper); ++j) {
+          M(i, j) = i == j ? 0.0 : u(rng);
+          // A strong push at the band's far edges, so that a contact pulls the slacks of the
+          // rows farthest from it below zero.
+          if (i != j && (j == i - lower || j == i + upper)) M(i, j) = -2.0;
+        }
+        M(i, i) = M.row(i).cwiseAbs().sum() / 0.4 + 1.0;
+      }
+      BandedLcpOptions options;
+      if (path == 1) options.dominance_limit = 0.0;  // factorise
+      BandedLcpSolver stepper(options);
+      stepper.set_matrix(BandedMatrix::from_dense_nonzeros(M));
+      REQUIRE(stepper.iterates() == (path == 0));
+      auto dense = make_block_pivoting_solver();
+      dense->set_matrix(M);
+      Vector z = Vector::Zero(n);
+      stepper.reset_active_set(z);
+      for (int k = 0; k < 60; ++k) {
+        Vector q(n);
+        for (Index i = 0; i < n; ++i) q[i] = 0.15 + 0.1 * std::sin(0.3 * k + static_cast<double>(i));
+        if (k % 20 < 12) q[0] = -1.0;                // the first spring, on and off
+        if (k >= 10 && k < 40) q[n - 1] = -0.8;      // the last
+        if (k >= 25) q[20] = -0.5 - 0.01 * k;        // alone, in the middle, from step 25
+        if (k >= 45) q[8] = -0.3;                    // another, nearer the first
+        stepper.solve_forces(q, z);
+        const Solved d = solve(*dense, q, Vector::Zero(n));
+        const Vector w = q + M * z;
+        INFO("lower " << lower << ", upper " << upper << ", path " << path << ", k " << k);
+        CHECK((z - d.z).cwiseAbs().maxCoeff() <= 1e-12 * (1 + d.z.cwiseAbs().maxCoeff()));
+        CHECK(w.minCoeff() >= -1e-12);
+        CHECK(z.minCoeff() >= 0.0);
+        CHECK(std::abs(z.dot(w)) <= 1e-12);
+      }
+    }
+  }
+}
+
+TEST_CASE("Sweeps that could not reach rounding within max_sweeps are not tried",
+          "[banded][lcp]") {
+  // ρ = 0.85 needs about 35 / -ln 0.85 = 218 sweeps from a cold start: more than the default
+  // 200, so a dominance limit of 0.9 still factorises, and iterates with 300 sweeps allowed.
+  std::mt19937 rng(12);
+  const Matrix M = dominant(30, 3, 0.85, rng);
+  BandedLcpOptions options;
+  options.dominance_limit = 0.9;
+  BandedLcpSolver capped(options);
+  capped.set_matrix(M);
+  CHECK(capped.dominance() > 0.8);
+  CHECK_FALSE(capped.iterates());
+  options.max_sweeps = 300;
+  BandedLcpSolver allowed(options);
+  allowed.set_matrix(M);
+  CHECK(allowed.iterates());
+  auto dense = make_block_pivoting_solver();
+  dense->set_matrix(M);
+  const Vector q = random_q(30, rng);
+  for (BandedLcpSolver* s : {&capped, &allowed}) {
+    const Solved a = solve(*s, q, Vector::Zero(30));
+    const Solved d = solve(*dense, q, Vector::Zero(30));
+    CHECK((a.z - d.z).cwiseAbs().maxCoeff() <= 1e-11 * (1 + d.z.cwiseAbs().maxCoeff()));
+  }
+  CHECK(capped.sweeps() == 0);
+  CHECK(allowed.factorized_rows() == 0);
 }
 
 TEST_CASE("On the step's matrix the stepper's LCP reaches rounding in two sweeps per active set",

@@ -24,6 +24,13 @@ constexpr double kSingularTol = 1e-13;
 // fraction of the largest force (a few units of rounding).
 constexpr double kSweepTol = 4.0 * std::numeric_limits<double>::epsilon();
 
+// Jacobi's error after a sweep that moved the forces by at most δ is at most δ ρ / (1 - ρ), so
+// the sweeps end once that is at rounding: for ρ of the step's matrix (about 1e-7) one sweep
+// fewer than waiting for a sweep that no longer moves them. Past ρ = 1/2 the bound exceeds the
+// move, whose own rounding would then never pass the test: the sweeps end on a move at
+// rounding, as Gauss-Seidel's did.
+double error_per_move(double rho) { return std::min(1.0, rho / (1.0 - rho)); }
+
 LcpError iteration_limit(long iteration, Index n) {
   return LcpError(fmt::format(
       "banded block pivoting: no solution after {} iterations (n = {}), the iteration limit "
@@ -88,7 +95,13 @@ void BandedLcpSolver::set_matrix(const BandedMatrix& M) {
                                     : std::numeric_limits<double>::infinity();
   }
   if (scale_ == 0.0) scale_ = 1.0;
-  iterate_ = dominance_ <= options_.dominance_limit;
+  // Sweeps from a cold start (a first move of the size of the forces) reach rounding after
+  // about log(kSweepTol / error_per_move) / log ρ of them (jacobi_sweeps); where that exceeds
+  // max_sweeps they would all be spent before the factorisation, so factorise from the start.
+  const double sweeps_to_rounding =
+      dominance_ > 0.0 ? std::log(kSweepTol / error_per_move(dominance_)) / std::log(dominance_) + 1.0
+                       : 1.0;
+  iterate_ = dominance_ <= options_.dominance_limit && sweeps_to_rounding <= options_.max_sweeps;
   lower_ = M_.lower_bandwidth();
   upper_ = M_.upper_bandwidth();
   columns_ = transpose(M_);
@@ -260,9 +273,9 @@ LcpResult BandedLcpSolver::solve_forces(const Eigen::Ref<const Vector>& q, Eigen
       s.solve_active(q, zd);
       // The slacks w_i = q_i + (M z)_i of the free indices that can be negative: those within
       // the band of an active one (rows j - upper .. j + lower of an active j) and those with
-      // q_i < 0. Each is one row of M against z (zero outside the active set), so the rows are
-      // independent of one another; the active set and negative_ are ascending, so one walk
-      // visits every candidate once, in order.
+      // q_i < 0. Each in a band is one row of M against z (zero outside the active set), so the
+      // rows are independent of one another; outside every band (M z)_i = 0 and w_i = q_i. The
+      // active set and negative_ are ascending, so one walk visits every candidate once.
       s.flips_.clear();
       for (int j : s.set_) {
         if (zd[j] < -tol.z) s.flips_.push_back(j);
@@ -275,9 +288,12 @@ LcpResult BandedLcpSolver::solve_forces(const Eigen::Ref<const Vector>& q, Eigen
       };
       Index next = 0;      // rows below it are listed
       std::size_t n = 0;   // into negative_
-      const auto negatives_below = [&](Index end) {
+      const auto negatives_below = [&](Index end) {  // between bands: w_i = q_i
         for (; n < s.negative_.size() && s.negative_[n] < end; ++n) {
-          if (s.negative_[n] >= next) candidate(s.negative_[n]);
+          const int i = s.negative_[n];
+          if (i >= next && !s.active_[static_cast<std::size_t>(i)] && q[i] < -tol.w) {
+            s.flips_.push_back(i);
+          }
         }
       };
       for (int j : s.set_) {
@@ -346,11 +362,8 @@ bool BandedLcpSolver::jacobi_sweeps(const Eigen::Ref<const Vector>& q, double* z
   // written after, so the rows are independent (Gauss-Seidel's are a chain of latencies, and its
   // vector loads of forces just stored stall on the store buffer). On a strictly diagonally
   // dominant M both contract by at most the dominance ρ per sweep (in the largest entry).
-  // Jacobi's error after a sweep that moved the forces by at most δ is then at most
-  // δ ρ / (1 - ρ), which ends the sweeps once it is at rounding: one sweep fewer than waiting
-  // for a sweep that no longer moves them (ρ of the step's matrix is about 1e-7).
   const auto N = set_.size();
-  const double error_per_move = dominance_ / (1.0 - dominance_);
+  const double stop_factor = error_per_move(dominance_);
   for (int sweep = 0; sweep < options_.max_sweeps; ++sweep) {
     ++sweeps_;
     M_.multiply_listed_rows(z, set_.data(), static_cast<Index>(N), next_.data());
@@ -365,7 +378,7 @@ bool BandedLcpSolver::jacobi_sweeps(const Eigen::Ref<const Vector>& q, double* z
       z[i] = next_[a];
       largest = std::max(largest, std::abs(z[i]));
     }
-    if (moved * error_per_move <= kSweepTol * largest) return true;
+    if (moved * stop_factor <= kSweepTol * largest) return true;
   }
   return false;
 }
