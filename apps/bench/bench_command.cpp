@@ -126,6 +126,10 @@ void add_scaling(CLI::App& bench) {
   c->add_option("--step", o->step, "Step (s)")->check(positive_number());
   c->add_option("--steps", o->steps, "Timed steps per repeat")->check(positive_number());
   c->add_option("--repeats", o->repeats, "Repeats (median)")->check(positive_number());
+  c->add_option("--work", o->work,
+                "Mass-steps each size repeats to at least (at most 200 repeats): small chains "
+                "repeat more")
+      ->check(positive_number());
   c->add_flag("--unshared", *unshared,
               "Store every operator row (no sharing of identical rows): the memory-bound case");
   c->add_option("--out", o->out, "Folder for bench_scaling.csv");

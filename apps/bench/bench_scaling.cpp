@@ -68,7 +68,8 @@ void run_scaling_single(long masses, const ScalingBenchOptions& o) {
   // Every size times the same stretch of motion (steps 20 .. 20 + steps from rest, so that the
   // springs act as much per mass), repeated until each size has done about the same work: a
   // short repeat of a small chain is otherwise at the mercy of the scheduler.
-  const long work = std::max<long>(1, 50'000'000L / (masses * o.steps));
+  const long work = std::max<long>(
+      1, static_cast<long>(o.work / (static_cast<double>(masses) * static_cast<double>(o.steps))));
   const int repeats = std::max<int>(o.repeats, static_cast<int>(std::min<long>(work, 200)));
   // Each repeat times the stretch of steps and then as many bare products T v (on copies of
   // the stepper's vectors), so that the ratio of the two is taken within one repeat: the
@@ -136,8 +137,9 @@ void run_scaling_single(long masses, const ScalingBenchOptions& o) {
 
 std::vector<ScalingRow> run_scaling_bench(const ScalingBenchOptions& o,
                                           const std::string& self_exe) {
-  if (o.sizes.empty() || o.steps < 1 || o.repeats < 1 || !(o.step > 0.0)) {
-    throw InputError("bench scaling: give at least one size, steps >= 1, repeats >= 1, step > 0");
+  if (o.sizes.empty() || o.steps < 1 || o.repeats < 1 || !(o.step > 0.0) || !(o.work > 0.0)) {
+    throw InputError(
+        "bench scaling: give at least one size, steps >= 1, repeats >= 1, step > 0, work > 0");
   }
   std::filesystem::create_directories(o.out);
   std::vector<ScalingRow> rows;
@@ -157,7 +159,9 @@ std::vector<ScalingRow> run_scaling_bench(const ScalingBenchOptions& o,
                                   "--steps",
                                   std::to_string(o.steps),
                                   "--repeats",
-                                  std::to_string(o.repeats)};
+                                  std::to_string(o.repeats),
+                                  "--work",
+                                  fmt::format("{:.17g}", o.work)};
     if (!o.share_rows) args.push_back("--unshared");
     std::vector<char*> argv;
     for (std::string& a : args) argv.push_back(a.data());

@@ -15,6 +15,7 @@ struct ScalingBenchOptions {
   double step = 0.02;       // s, the paper's step
   int steps = 1000;         // timed steps per repeat (after 20 steps from rest)
   int repeats = 5;          // at least; small chains repeat more (same work per size)
+  double work = 5e7;        // mass-steps each size repeats to at least, up to 200 repeats
   bool share_rows = true;   // false: every operator row stored (shows the memory-bound case)
   std::string out = "out/bench";
   bool quiet = false;
