@@ -75,7 +75,7 @@ void run_scaling_single(long masses, const ScalingBenchOptions& o) {
   // the stepper's vectors), so that the ratio of the two is taken within one repeat: the
   // machine's speed drifts between repeats more than the ratio does.
   const BandedStepOperators& ops = propagator.operators();
-  Vector state, out;
+  Vector state, out(propagator.state().size());
   volatile double sink = 0.0;
   std::vector<double> per_step, per_product, ratios;
   for (int r = 0; r < repeats; ++r) {
@@ -85,7 +85,6 @@ void run_scaling_single(long masses, const ScalingBenchOptions& o) {
     for (int k = 0; k < o.steps; ++k) propagator.step();
     per_step.push_back(1e6 * (thread_seconds() - c0) / o.steps);
     state = propagator.state();
-    out.resize(state.size());
     const double c1 = thread_seconds();
     for (int k = 0; k < o.steps; ++k) {
       ops.transition.multiply(state.data(), out.data());

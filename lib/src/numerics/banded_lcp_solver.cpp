@@ -366,16 +366,14 @@ bool BandedLcpSolver::jacobi_sweeps(const Eigen::Ref<const Vector>& q, double* z
   const double stop_factor = error_per_move(dominance_);
   for (int sweep = 0; sweep < options_.max_sweeps; ++sweep) {
     ++sweeps_;
+    // Every row product is formed before any force is written.
     M_.multiply_listed_rows(z, set_.data(), static_cast<Index>(N), next_.data());
-    for (std::size_t a = 0; a < N; ++a) {
-      const int i = set_[a];
-      next_[a] = z[i] - (q[i] + next_[a]) * inverse_diagonal_[i];
-    }
     double moved = 0.0, largest = 0.0;
     for (std::size_t a = 0; a < N; ++a) {
       const int i = set_[a];
-      moved = std::max(moved, std::abs(next_[a] - z[i]));
-      z[i] = next_[a];
+      const double update = -(q[i] + next_[a]) * inverse_diagonal_[i];
+      z[i] += update;
+      moved = std::max(moved, std::abs(update));
       largest = std::max(largest, std::abs(z[i]));
     }
     if (moved * stop_factor <= kSweepTol * largest) return true;

@@ -162,12 +162,18 @@ constexpr std::array<RowKernel, sizeof...(Ws) + 1> kernel_table(std::integer_seq
   return {&generic_rows<Add>, &fixed_rows<Ws + 1, Add>...};
 }
 
+// A table's kernel for a width: the compile-time one up to kFixedWidths, the run-time loop
+// (entry 0) past it.
+template <class Table>
+auto kernel_for_width(const Table& table, Index width) {
+  return width >= 1 && width <= kFixedWidths ? table[static_cast<std::size_t>(width)] : table[0];
+}
+
 template <bool Add>
 RowKernel row_kernel(Index width) {
   static constexpr auto table =
       kernel_table<Add>(std::make_integer_sequence<int, kFixedWidths>{});
-  return width >= 1 && width <= kFixedWidths ? table[static_cast<std::size_t>(width)]
-                                             : table[0];
+  return kernel_for_width(table, width);
 }
 
 // Listed rows: out[c] = a_{rows[c]} · x[first ..], the width fixed at compile time as above.
@@ -198,8 +204,7 @@ constexpr std::array<ListedKernel, sizeof...(Ws) + 1> listed_table(
 
 ListedKernel listed_kernel(Index width) {
   static constexpr auto table = listed_table(std::make_integer_sequence<int, kFixedWidths>{});
-  return width >= 1 && width <= kFixedWidths ? table[static_cast<std::size_t>(width)]
-                                             : table[0];
+  return kernel_for_width(table, width);
 }
 
 void check_range(Index r0, Index r1, Index rows) {
