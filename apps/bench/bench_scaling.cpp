@@ -68,9 +68,9 @@ void run_scaling_single(long masses, const ScalingBenchOptions& o) {
   // Every size times the same stretch of motion (steps 20 .. 20 + steps from rest, so that the
   // springs act as much per mass), repeated until each size has done about the same work: a
   // short repeat of a small chain is otherwise at the mercy of the scheduler.
-  const long work = std::max<long>(
-      1, static_cast<long>(o.work / (static_cast<double>(masses) * static_cast<double>(o.steps))));
-  const int repeats = std::max<int>(o.repeats, static_cast<int>(std::min<long>(work, 200)));
+  // In double and capped before the cast: a --work past the range of an integer asks for the cap.
+  const double work = o.work / (static_cast<double>(masses) * static_cast<double>(o.steps));
+  const int repeats = std::max(o.repeats, static_cast<int>(std::clamp(work, 1.0, 200.0)));
   // Each repeat times the stretch of steps and then as many bare products T v (on copies of
   // the stepper's vectors), so that the ratio of the two is taken within one repeat: the
   // machine's speed drifts between repeats more than the ratio does.
