@@ -45,6 +45,19 @@ std::unique_ptr<Integrator> reference(const GapStructure& s, const Vector& x0) {
 
 namespace {
 
+// The chain with the masses and gaps of cells [first, last) varied (1 to 1.3 kg, gaps of
+// +-0.05 m), the others 1 kg and 0 m.
+ChainParameters with_cells_varied(ChainParameters p, int first, int last) {
+  const auto n = static_cast<std::size_t>(p.masses);
+  if (p.mass.size() != n) p.mass.assign(n, 1.0);
+  if (p.gap.size() != n) p.gap.assign(n, 0.0);
+  for (int i = first; i < last; ++i) {
+    p.mass[static_cast<std::size_t>(i)] = 1.0 + 0.3 * std::abs(std::sin(0.7 * i));
+    p.gap[static_cast<std::size_t>(i)] = 0.05 * std::cos(1.3 * i);
+  }
+  return p;
+}
+
 // The dense and the banded stepper from rest, side by side for `steps` steps of eta.
 struct FromRest {
   double worst = 0.0;    // largest difference of x and x' at the steps
@@ -151,13 +164,7 @@ TEST_CASE("banded switching PIM: the windowed gap screen keeps steps without a s
   // second has cells that all differ (operators row by row); the third switches in its middle
   // only, every other gap out of reach (windows open on both sides). A window costs a quarter of
   // the rows at most, so the chains are a few hundred masses long.
-  ChainParameters varied = paper_large_chain(300);
-  varied.mass.assign(300, 1.0);
-  varied.gap.assign(300, 0.0);
-  for (int i = 0; i < 300; ++i) {
-    varied.mass[static_cast<std::size_t>(i)] = 1.0 + 0.3 * std::abs(std::sin(0.7 * i));
-    varied.gap[static_cast<std::size_t>(i)] = 0.05 * std::cos(1.3 * i);
-  }
+  const ChainParameters varied = with_cells_varied(paper_large_chain(300), 0, 300);
   ChainParameters middle = paper_large_chain(600);
   middle.gap.assign(600, 5.0);
   for (int i = 290; i < 310; ++i) middle.gap[static_cast<std::size_t>(i)] = 0.02 * (i % 3);
@@ -609,6 +616,71 @@ TEST_CASE("banded switching PIM: local and global switch corrections agree",
     CHECK(da.switching_steps == db.switching_steps);
     CHECK(largest > 0.5);
     CHECK(worst < 1e-13 * largest);
+  }
+}
+
+TEST_CASE("banded switching PIM: local steps on the free motion agree with the whole state's series",
+          "[banded][switching][local]") {
+  // A locally corrected step may split its motion as the free motion (every spring open: its
+  // end T y, its gaps from its series on windows of rows around the springs the gap screen left)
+  // plus the correction of the springs touching at the start and of those that switch
+  // (windowed_free_motion, the default). Against the same local correction on the whole state's
+  // series of the start mode, and against steps redone on the whole state: the same switching
+  // steps and switches, states within 1e-13 of the motion's size. The windows (about 4 K + 1
+  // rows, K the series' length) must cover less than a quarter of the rows, so the chains are
+  // long: the paper's chain, which drifts and switches near its ends (windows cut by an end),
+  // and the same with cells that differ at both ends (the operators' rows there apart from the
+  // stencil, and the windows' products on them row by row).
+  const ChainParameters ends =
+      with_cells_varied(with_cells_varied(paper_large_chain(400), 0, 16), 384, 400);
+  struct Case {
+    const char* name;
+    ChainParameters chain;
+    int steps;
+  };
+  for (const Case& c : {Case{"paper's chain", paper_large_chain(1000), 150},
+                        Case{"cells that differ at the ends", ends, 200}}) {
+    INFO(c.name);
+    const GapStructure s = make_chain(c.chain);
+    const Index n = s.dofs();
+    const double eta = 0.4;
+    BandedSwitchingPimOptions free = banded_options(eta), series = free, whole = free;
+    free.switch_correction = series.switch_correction = BandedSwitchingPimOptions::SwitchCorrection::local;
+    series.windowed_free_motion = false;
+    whole.switch_correction = BandedSwitchingPimOptions::SwitchCorrection::whole_state;
+    auto a = make_banded_switching_pim(s, free);
+    auto b = make_banded_switching_pim(s, series);
+    auto w = make_banded_switching_pim(s, whole);
+    for (Integrator* p : {static_cast<Integrator*>(a.get()), static_cast<Integrator*>(b.get()),
+                          static_cast<Integrator*>(w.get())}) {
+      p->set_state(0.0, Vector::Zero(n), Vector::Zero(n));
+    }
+    double to_series = 0.0, to_whole = 0.0, largest = 0.0;
+    for (int k = 1; k <= c.steps; ++k) {
+      a->advance_to(k * eta);
+      b->advance_to(k * eta);
+      w->advance_to(k * eta);
+      to_series = std::max(to_series, (state_of(*a) - state_of(*b)).cwiseAbs().maxCoeff());
+      to_whole = std::max(to_whole, (state_of(*a) - state_of(*w)).cwiseAbs().maxCoeff());
+      largest = std::max(largest, state_of(*w).cwiseAbs().maxCoeff());
+    }
+    const SwitchingPimDiagnostics da = a->diagnostics(), db = b->diagnostics(), dw = w->diagnostics();
+    INFO("switches " << da.switches << " / " << db.switches << " / " << dw.switches
+                     << ", switching steps " << da.switching_steps << " (" << da.local_steps
+                     << " local, " << da.free_windowed << " on the free motion) / "
+                     << db.switching_steps << " / " << dw.switching_steps << ", largest " << largest
+                     << ", difference " << to_series << " / " << to_whole);
+    CHECK(da.switches > 80);
+    CHECK(da.free_windowed > 0.6 * static_cast<double>(da.local_steps));
+    CHECK(db.free_windowed == 0);
+    CHECK(dw.free_windowed == 0);
+    CHECK(da.switching_steps == db.switching_steps);
+    CHECK(da.switching_steps == dw.switching_steps);
+    CHECK(std::abs(da.switches - db.switches) <= db.switches / 50);
+    CHECK(std::abs(da.switches - dw.switches) <= dw.switches / 50);
+    CHECK(largest > 1.0);
+    CHECK(to_series < 1e-13 * largest);
+    CHECK(to_whole < 1e-13 * largest);
   }
 }
 

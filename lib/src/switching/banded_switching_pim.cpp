@@ -208,7 +208,8 @@ class BandedStepper final : public SwitchingPim,
   BandedStepper(const GapStructure& s, const BandedSwitchingPimOptions& options)
       : o_(options.pim), n_(s.dofs()), m_(s.spring_count()), d_(options.pim.force_degree),
         eta_(options.pim.step), end_derivative_(options.pim.end_derivative),
-        correction_mode_(options.switch_correction), solver_(options.lcp) {
+        correction_mode_(options.switch_correction), free_windows_(options.windowed_free_motion),
+        solver_(options.lcp) {
     // Sparse parts of the equation of motion, springs by position along the structure.
     const Vector inverse_mass = s.mass.diagonal().cwiseInverse();
     banded_detail::OrderedSprings springs = banded_detail::ordered_springs(s);
@@ -617,15 +618,15 @@ class BandedStepper final : public SwitchingPim,
     if (forces) force_band_.multiply_add(p.data(), acc.data());
   }
   // (W^T x)_j: spring j's stretch in the displacement x, from its sparse row. x is read by row
-  // index: a whole-state Vector, or a window's rows (local_gap_screen.hpp).
+  // index (a whole-state Vector, or the local corrections' terms).
   template <class Rows>
   double spring_stretch(Index j, const Rows& x) const {
     double g = 0.0;
     for (RowSparse::InnerIterator it(gap_rows_, j); it; ++it) g += it.value() * x[it.col()];
     return g;
   }
-  // Row i of -M⁻¹ (K x + C u + W p) from the sparse rows, p_j = force_of(j): the windowed series
-  // (the local switch corrections', the smooth steps' tangent recursion, the second gap screen's)
+  // Row i of -M⁻¹ (K x + C u + W p) from the sparse rows, p_j = force_of(j): the series on rows
+  // that are not windows (the local switch corrections' δ, the smooth steps' tangent recursion)
   // row by row; x and u as for spring_stretch.
   template <class Rows, class ForceOf>
   double row_acceleration(Index i, const Rows& x, const Rows& u, ForceOf&& force_of) const {
@@ -648,6 +649,111 @@ class BandedStepper final : public SwitchingPim,
     return 64.0 * kEpsilon * (std::abs(gaps_[j]) + reach + abs_row_sums_[j] * x_scale_);
   }
   void begin_piece() { collect_acting(); }
+  // The scaled Taylor terms of the motion about time t for the step η, from the start in
+  // xs_[0], us_[0], in the current mode or, with `free`, with every spring open, on the rows of
+  // `windows` only, with the whole state's banded stencils restricted to them. The r-th term
+  // couples rows at most r · reach apart (K, C and the springs' two ends), so on a window it is
+  // exactly the whole state's term on the rows at least r · reach from an edge of the window
+  // that is not an end of the structure; each term is computed there only, from the exact rows
+  // of the term before. (A touching spring's force is read only by rows next to its own, so it
+  // is exact where it is read.) After each term r, record(w, r, x_r, first, last) for each
+  // window w, x_r whole-size and exact on its rows [first, last). Stops once two consecutive
+  // terms are below ε/2 of the largest entry seen (at least `scale`; the result in *largest),
+  // measured on the exact rows, not before 4 terms: a stopping rule of the same kind as the
+  // whole state's (ModeSeries::taylor), not a bound. Returns the last term's index, or -1 when K
+  // terms do not get there. O(window rows) per term, whatever n. The finite reach of each term
+  // is what makes banded exponentials of chains possible in the first place (He, Gao & Zhong,
+  // Appl. Math. Mech. 39(7) (2018) 737-749).
+  template <class Record>
+  int window_series(double t, const switching_detail::RowRanges& windows, int K, double scale,
+                    bool free, double* largest, Record&& record) {
+    for (Vector* v : {&free_x_[0], &free_x_[1], &free_u_[0], &free_u_[1], &free_acc_}) {
+      if (v->size() != n_) v->setZero(n_);
+    }
+    if (free_force_.size() != m_) free_force_.setZero(m_);
+    const bool forces = !free && !acting_.empty();
+    const std::size_t groups = loads_.size();
+    free_sin_.resize(groups);
+    free_cos_.resize(groups);
+    free_scale_.resize(groups);
+    for (std::size_t g = 0; g < groups; ++g) {
+      free_sin_[g] = std::sin(loads_[g].omega * t);
+      free_cos_[g] = std::cos(loads_[g].omega * t);
+      free_scale_[g] = 1.0;
+    }
+    const auto& ranges = windows.ranges();
+    const auto first_row = [&](std::size_t w, int r) {
+      const Index lo = ranges[w].first, hi = ranges[w].second;
+      return lo > 0 ? std::min<Index>(hi, lo + r * reach_) : lo;
+    };
+    const auto last_row = [&](std::size_t w, int r) {
+      const Index hi = ranges[w].second;
+      return hi < n_ ? std::max<Index>(first_row(w, r), hi - r * reach_) : hi;
+    };
+    const Vector* x = &xs_[0];
+    const Vector* u = &us_[0];
+    double size = 0.0;
+    for (std::size_t w = 0; w < ranges.size(); ++w) {
+      const Index a = first_row(w, 0), b = last_row(w, 0);
+      record(w, 0, *x, a, b);
+      for (Index i = a; i < b; ++i) size = std::max({size, std::abs((*x)[i]), std::abs((*u)[i])});
+    }
+    double big = std::max(scale, size), previous = size;
+    for (int r = 0; r < K; ++r) {
+      const double f = eta_ / (r + 1);
+      Vector& x1 = free_x_[static_cast<std::size_t>(r % 2)];
+      Vector& u1 = free_u_[static_cast<std::size_t>(r % 2)];
+      size = 0.0;
+      if (forces) {
+        // The touching springs' forces from term r (the offset in the first); read only where
+        // exact (above).
+        for (int j : acting_) {
+          const double force = stiffnesses_[j] * spring_stretch(j, *x);
+          free_force_[j] = r == 0 ? force - spring_offset_[j] : force;
+        }
+      }
+      for (std::size_t w = 0; w < ranges.size(); ++w) {
+        const Index a = first_row(w, r + 1), b = last_row(w, r + 1);
+        stiffness_band_.multiply(x->data(), free_acc_.data(), a, b);
+        damping_band_.multiply_add(u->data(), free_acc_.data(), a, b);
+        if (forces) force_band_.multiply_add(free_force_.data(), free_acc_.data(), a, b);
+        for (std::size_t g = 0; g < groups; ++g) {
+          // d^r/dt^r of sin and cos at ωt, scaled by (ωη)^r / r!.
+          double ds = 0.0, dc = 0.0;
+          switching_detail::harmonic_derivative(r, free_sin_[g], free_cos_[g], ds, dc);
+          const double scale_g = free_scale_[g];
+          if (scale_g == 0.0) continue;
+          for (Index i = a; i < b; ++i) {
+            free_acc_[i] += scale_g * (ds * loads_[g].sin_part[i] + dc * loads_[g].cos_part[i]);
+          }
+        }
+        for (Index i = a; i < b; ++i) {
+          x1[i] = f * (*u)[i];
+          u1[i] = f * free_acc_[i];
+          size = std::max({size, std::abs(x1[i]), std::abs(u1[i])});
+        }
+        record(w, r + 1, x1, a, b);
+      }
+      for (std::size_t g = 0; g < groups; ++g) free_scale_[g] *= loads_[g].omega * eta_ / (r + 1);
+      x = &x1;
+      u = &u1;
+      big = std::max(big, size);
+      *largest = big;
+      if (r + 1 >= 4 && size + previous <= 0.5 * kEpsilon * big) return r + 1;
+      previous = size;
+    }
+    return -1;
+  }
+  // The end of the step from state_ when no spring touches: T y plus the loads' responses, the
+  // smooth step's formula, which has no spring force to approximate then (the phases of the
+  // step's start, from its series), into x and x'.
+  void free_motion_end(Vector& x, Vector& u) {
+    transition_.multiply(state_.data(), bar_.data());
+    for (std::size_t g = 0; g < harmonics_.size(); ++g) {
+      bar_ += phase_sin_[g] * harmonics_[g].sin_response + phase_cos_[g] * harmonics_[g].cos_response;
+    }
+    deinterleave_state(bar_, x, u);
+  }
   void end_pieces() {
     for (Index i = 0; i < n_; ++i) {
       state_[2 * i] = xs_[0][i];
@@ -770,6 +876,7 @@ class BandedStepper final : public SwitchingPim,
   double eta_;
   bool end_derivative_;
   BandedSwitchingPimOptions::SwitchCorrection correction_mode_;
+  bool free_windows_;  // BandedSwitchingPimOptions::windowed_free_motion
   int local_skip_ = 0, local_backoff_ = 1;
   Index reach_ = 0;
   BandedLcpSolver solver_;
@@ -794,6 +901,8 @@ class BandedStepper final : public SwitchingPim,
   long steps_ = 0;
   double x_scale_ = 0.0;
   Vector position_, velocity_;
+  Vector free_x_[2], free_u_[2], free_acc_, free_force_;  // window_series' terms, alternately
+  std::vector<double> free_sin_, free_cos_, free_scale_;
   IntegratorStats stats_;
   SwitchingPimDiagnostics diagnostics_;
 

@@ -157,11 +157,16 @@ struct CandidateSprings {
   event_detail::GapSample start;
   Vector rest_;  // scratch of select()
 
-  void select(const PolynomialGaps& all, const event_detail::SearchSettings& all_settings) {
+  // From the polynomials of every spring (row j is spring j), or, with `names`, of some springs
+  // of a set of `total`: row k of `all` is spring names[k] (ascending), and springs and row_of
+  // speak of the whole set.
+  void select(const PolynomialGaps& all, const event_detail::SearchSettings& all_settings,
+              const Index* names = nullptr, Index total = 0) {
     const Matrix& c = all.c;
     const Index m = c.rows(), R = c.cols() - 1;
     springs.clear();
-    row_of.assign(static_cast<std::size_t>(m), -1);
+    row_of.assign(static_cast<std::size_t>(names == nullptr ? m : total), -1);
+    const auto name = [&](Index j) { return names == nullptr ? j : names[j]; };
     // S_j = Σ_{r>=2} |c(j, r)| column by column (contiguous; the same sums in the same order).
     rest_.setZero(m);
     for (Index r = 2; r <= R; ++r) rest_ += c.col(r).cwiseAbs();
@@ -175,8 +180,9 @@ struct CandidateSprings {
                          all_settings.tolerance[j] == 0.0 &&
                          !(all_settings.certified_until[j] > 0.0);
       if (clear) continue;
-      row_of[static_cast<std::size_t>(j)] = static_cast<int>(springs.size());
-      springs.push_back(j);
+      row_of[static_cast<std::size_t>(name(j))] = static_cast<int>(rows_.size());
+      rows_.push_back(j);
+      springs.push_back(name(j));
     }
     const auto count = static_cast<Index>(springs.size());
     poly.c.resize(count, R + 1);
@@ -184,11 +190,12 @@ struct CandidateSprings {
     settings.tolerance.resize(count);
     settings.certified_until.resize(count);
     for (Index k = 0; k < count; ++k) {
-      const Index j = springs[static_cast<std::size_t>(k)];
+      const Index j = rows_[static_cast<std::size_t>(k)];
       poly.c.row(k) = c.row(j);
       settings.tolerance[k] = all_settings.tolerance[j];
       settings.certified_until[k] = all_settings.certified_until[j];
     }
+    rows_.clear();
     start = event_detail::GapSample();
     poly.sample(start, 0.0, start);
   }
@@ -197,6 +204,9 @@ struct CandidateSprings {
     out.clear();
     for (Index k : r.springs) out.push_back(springs[static_cast<std::size_t>(k)]);
   }
+
+ private:
+  std::vector<Index> rows_;  // scratch of select(): the kept rows of `all`
 };
 
 // The coefficients of the step's force polynomial from the moments Ξ̂_0 .. Ξ̂_{d+1} (Ξ̂_{d+2} with

@@ -34,7 +34,11 @@
 // (O(n) per term, sparse H), and from the first switch on the series of the correction the
 // switches make, on the rows it reaches (O(window) per term); switches are located on the gap
 // polynomials by the safeguarded root search of event_location.hpp
-// (local_switch_correction.hpp). Where springs switch all along the chain at once the stepper
+// (local_switch_correction.hpp). Where that is enough (windowed_free_motion), the motion the
+// correction is added to is the free one, every spring open, whose end is T y (exact: no spring
+// force to approximate) and whose gaps come from its series on windows of rows around the
+// springs that may switch and those touching, which are then sources of the correction from the
+// step's start: one product T y and O(window) per term instead of the whole state's series. Where springs switch all along the chain at once the stepper
 // redoes the step on the whole state instead, as the dense stepper does (switch_correction).
 // Before that, a step whose gap screen (the gap polynomials of degree d + 1) cannot clear every
 // spring is screened again on the gap polynomials to rounding of the springs it left, from the
@@ -101,6 +105,12 @@ struct BandedSwitchingPimOptions {
   // The three agree to rounding.
   enum class SwitchCorrection { automatic, local, whole_state };
   SwitchCorrection switch_correction = SwitchCorrection::automatic;
+  // A locally corrected step that starts with no spring touching takes the motion without its
+  // switches from the smooth step's T y (exact then: there is no spring force to approximate)
+  // and that motion's gap polynomials from its series on windows of rows around the springs the
+  // gap screen left, instead of from the series of the whole state. false: the whole state's
+  // series, as every other switching step (the two agree to rounding).
+  bool windowed_free_motion = true;
   // Ceres-style check: false with a message naming the field (pim.step, band.tolerance, ...)
   // and its value.
   bool is_valid(std::string* why) const;

@@ -136,6 +136,8 @@ struct SwitchingPimDiagnostics {
   long switching_steps = 0;  // steps redone in pieces
   long local_steps = 0;      // of those, corrected locally (banded stepper)
   long local_rows = 0;       // rows of their corrections' series, summed over their pieces
+  long free_windowed = 0;    // of the local ones, with the motion without the switches from
+                             // T y and its gaps from windows (banded stepper, no spring touching)
   long halved_pieces = 0;    // pieces of switching steps halved for their series to converge
   long pieces = 0;           // pieces of those steps
   long switches = 0;         // located spring switches
