@@ -628,18 +628,25 @@ TEST_CASE("banded switching PIM: local steps on the free motion agree with the w
   // series of the start mode, and against steps redone on the whole state: the same switching
   // steps and switches, states within 1e-13 of the motion's size. The windows (about 4 K + 1
   // rows, K the series' length) must cover less than a quarter of the rows, so the chains are
-  // long: the paper's chain, which drifts and switches near its ends (windows cut by an end),
-  // and the same with cells that differ at both ends (the operators' rows there apart from the
-  // stencil, and the windows' products on them row by row).
+  // long: the paper's chain, which drifts and switches near its ends (windows cut by an end);
+  // the same with cells that differ at both ends (the operators' rows there apart from the
+  // stencil, and the windows' products on them row by row); and one whose springs are out of
+  // reach but for 20 in its middle, among cells that differ (windows open on both sides).
   const ChainParameters ends =
       with_cells_varied(with_cells_varied(paper_large_chain(400), 0, 16), 384, 400);
+  ChainParameters middle = with_cells_varied(paper_large_chain(1000), 480, 520);
+  for (int i = 0; i < 1000; ++i) {
+    middle.gap[static_cast<std::size_t>(i)] = i >= 490 && i < 510 ? 0.02 * (i % 3) : 5.0;
+  }
   struct Case {
     const char* name;
     ChainParameters chain;
     int steps;
+    long switches;  // at least
   };
-  for (const Case& c : {Case{"paper's chain", paper_large_chain(1000), 150},
-                        Case{"cells that differ at the ends", ends, 200}}) {
+  for (const Case& c : {Case{"paper's chain", paper_large_chain(1000), 150, 80},
+                        Case{"cells that differ at the ends", ends, 200, 80},
+                        Case{"switches in the middle", middle, 250, 20}}) {
     INFO(c.name);
     const GapStructure s = make_chain(c.chain);
     const Index n = s.dofs();
@@ -670,12 +677,14 @@ TEST_CASE("banded switching PIM: local steps on the free motion agree with the w
                      << " local, " << da.free_windowed << " on the free motion) / "
                      << db.switching_steps << " / " << dw.switching_steps << ", largest " << largest
                      << ", difference " << to_series << " / " << to_whole);
-    CHECK(da.switches > 80);
+    CHECK(da.switches >= c.switches);
     CHECK(da.free_windowed > 0.6 * static_cast<double>(da.local_steps));
     CHECK(db.free_windowed == 0);
     CHECK(dw.free_windowed == 0);
     CHECK(da.switching_steps == db.switching_steps);
     CHECK(da.switching_steps == dw.switching_steps);
+    // As in the test above, a spring grazing its kink within rounding may make a pair of
+    // switches in one form and none in another.
     CHECK(std::abs(da.switches - db.switches) <= db.switches / 50);
     CHECK(std::abs(da.switches - dw.switches) <= dw.switches / 50);
     CHECK(largest > 1.0);

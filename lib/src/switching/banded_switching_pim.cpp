@@ -671,7 +671,12 @@ class BandedStepper final : public SwitchingPim,
       if (v->size() != n_) v->setZero(n_);
     }
     if (free_force_.size() != m_) free_force_.setZero(m_);
+    // The force band reads every spring attached to a row: the entries of the springs that
+    // touched in the last call go back to zero.
+    for (int j : force_set_) free_force_[j] = 0.0;
+    force_set_.clear();
     const bool forces = !free && !acting_.empty();
+    if (forces) force_set_ = acting_;
     const std::size_t groups = loads_.size();
     free_sin_.resize(groups);
     free_cos_.resize(groups);
@@ -744,9 +749,19 @@ class BandedStepper final : public SwitchingPim,
     }
     return -1;
   }
-  // The end of the step from state_ when no spring touches: T y plus the loads' responses, the
-  // smooth step's formula, which has no spring force to approximate then (the phases of the
-  // step's start, from its series), into x and x'.
+  // True when every spring's gap in the displacement x is on its mode's side of the kink (within
+  // the kink tolerance): the check a smooth step's LCP makes at its end.
+  bool modes_hold(const Vector& x) {
+    end_gaps_.resize(m_);
+    gap_band_.multiply(x.data(), end_gaps_.data());
+    for (Index j = 0; j < m_; ++j) {
+      if (signs_[j] * (end_gaps_[j] - gaps_[j]) < -kink_tolerance(j)) return false;
+    }
+    return true;
+  }
+  // The end of the free motion (every spring open) over the step from state_: T y plus the
+  // loads' responses, the smooth step's formula with no spring force to approximate (the phases
+  // of the step's start, from its series), into x and x'.
   void free_motion_end(Vector& x, Vector& u) {
     transition_.multiply(state_.data(), bar_.data());
     for (std::size_t g = 0; g < harmonics_.size(); ++g) {
@@ -903,6 +918,8 @@ class BandedStepper final : public SwitchingPim,
   Vector position_, velocity_;
   Vector free_x_[2], free_u_[2], free_acc_, free_force_;  // window_series' terms, alternately
   std::vector<double> free_sin_, free_cos_, free_scale_;
+  std::vector<int> force_set_;  // the springs whose free_force_ entry may be non-zero
+  Vector end_gaps_;  // scratch of modes_hold
   IntegratorStats stats_;
   SwitchingPimDiagnostics diagnostics_;
 

@@ -46,8 +46,11 @@
 // The step goes back to the whole state's series when the screen left no spring (a switch found
 // by the LCP), when the windows cover a quarter of the rows, when a window's series does not
 // converge within K terms, when a spring the screen left sits on its kink pointing the other way,
-// or when δ reaches a spring beyond the windows' exact rows. The two forms agree to rounding (the
-// exponential T is exact to rounding), not to the bit. On the paper's 1000-mass chain at η = 0.4 s
+// when δ reaches a spring beyond the windows' exact rows, or when a spring ends the step on the
+// wrong side of its kink for its mode (the end check a smooth step's LCP makes, here on the
+// springs the searches trusted to the screen). The two forms agree to rounding and the band's
+// truncation of T (1e-15 of each block), not to the bit; steps with a tangent or its record
+// always take the whole state's series. On the paper's 1000-mass chain at η = 0.4 s
 // from rest to 200 s, 186 of its 193 local steps take the free motion.
 //
 // The tangent map follows the same split with the same pieces: the whole-step series of y_u's
@@ -199,9 +202,9 @@ class LocalSwitchCorrection {
   // correction's rows exceed max_rows (then *too_wide is set; the work done is dropped).
   bool local_switching_step(double t0, const char* method, Index max_rows, bool* too_wide) {
     Stepper& st = me();
-    if (st.free_windows_ && st.tangent_ == nullptr && !st.noting()) {
-      const FreeOutcome outcome = free_motion_step(t0, method, max_rows, too_wide);
-      if (outcome != FreeOutcome::fall_back) return outcome == FreeOutcome::done;
+    if (st.free_windows_ && st.tangent_ == nullptr && !st.noting() &&
+        free_motion_step(t0, method, max_rows)) {
+      return true;
     }
     const int max_terms = st.o_.max_series_terms;
     int R = 0;
@@ -238,10 +241,7 @@ class LocalSwitchCorrection {
       const event_detail::SearchResult& first = st.locator_.find_first_crossing(
           outside_.poly, outside_.start, 1.0, outside_.settings);
       st.diagnostics_.gap_samples += first.samples;
-      if (!first.found) {
-        finish_local(std::move(record), keep);
-        return true;
-      }
+      if (!first.found) return finish_local(std::move(record), keep);
       sigma_ = first.at.t;
       outside_.springs_of(first, found_);
     }
@@ -257,8 +257,6 @@ class LocalSwitchCorrection {
   }
 
  private:
-  enum class FreeOutcome { done, too_wide, fall_back };
-
   // The local switching step on the free motion (see the file's comment): y_u is the motion with
   // every spring open, its end T y from the stepper (free_motion_end), its gap polynomials from
   // its series on windows of rows around the springs the step's gap screen left and the springs
@@ -267,7 +265,7 @@ class LocalSwitchCorrection {
   // spring left by the screen (an LCP mismatch), windows over a quarter of the rows, a window's
   // series that does not converge, a spring on its kink that must switch at the start, or a
   // correction that reaches springs beyond the windows' exact rows.
-  FreeOutcome free_motion_step(double t0, const char* method, Index max_rows, bool* too_wide) {
+  bool free_motion_step(double t0, const char* method, Index max_rows) {
     Stepper& st = me();
     const int max_terms = st.o_.max_series_terms;
     free_springs_.clear();
@@ -277,7 +275,7 @@ class LocalSwitchCorrection {
       flagged = true;
       if (!(st.mode_[j] > 0.0)) free_springs_.push_back(j);
     }
-    if (!flagged) return FreeOutcome::fall_back;
+    if (!flagged) return false;
     // Each window: the springs' rows widened by K reaches for y_u's own series of up to K terms
     // and as many again for the springs the correction's series reaches. K follows the series
     // down to 4 terms more than they needed (one less per step, as the gap screen's windows);
@@ -293,7 +291,7 @@ class LocalSwitchCorrection {
     for (Index j : free_springs_) add_window(j);
     for (int j : st.acting_) add_window(j);
     free_ranges_.normalize();
-    if (4 * free_ranges_.rows() >= st.n_) return FreeOutcome::fall_back;
+    if (4 * free_ranges_.rows() >= st.n_) return false;
     // The scale of the whole state's series: the screen's terms (x to d + 1, x' to d).
     double scale = 0.0;
     for (int r = 0; r <= st.d_ + 1; ++r) {
@@ -333,7 +331,7 @@ class LocalSwitchCorrection {
     if (R < 0) {
       free_terms_ = 0;
       reset_free();
-      return FreeOutcome::fall_back;
+      return false;
     }
     free_terms_ = std::max(R + 4, K - 1);
     for (std::size_t k = 0; k < free_named_.size(); ++k) {
@@ -347,7 +345,7 @@ class LocalSwitchCorrection {
       const int row = free_row_[static_cast<std::size_t>(j)];
       if (row < 0) {
         reset_free();
-        return FreeOutcome::fall_back;
+        return false;
       }
       const double sign = st.signs_[j];
       for (int r = 0; r <= R; ++r) {
@@ -357,7 +355,7 @@ class LocalSwitchCorrection {
     }
     if (st.settle_kinks(free_poly_, free_springs_.data(), free_start_, free_settings_, flips_)) {
       reset_free();
-      return FreeOutcome::fall_back;
+      return false;
     }
     free_base_ = true;
     free_short_ = false;
@@ -368,35 +366,40 @@ class LocalSwitchCorrection {
     terms_u_ = R;
     base_mode_.setZero(st.m_);
     scale_ = scale;
-    outside_.select(free_poly_, free_settings_, free_springs_.data(), st.m_);
+    outside_.select(free_poly_, free_settings_, &free_springs_, st.m_);
     found_.clear();
     sigma_ = 0.0;
-    if (st.acting_.empty()) {
-      // δ starts at the first switch, located on y_u.
-      const event_detail::SearchResult& first = st.locator_.find_first_crossing(
-          outside_.poly, outside_.start, 1.0, outside_.settings);
-      st.diagnostics_.gap_samples += first.samples;
-      if (!first.found) {
-        finish_local(LocalStep(), false);
-        return FreeOutcome::done;
-      }
-      sigma_ = first.at.t;
-      outside_.springs_of(first, found_);
-    }
     ensure_terms(max_terms);
     bool done = false;
     try {
-      done = local_pieces(t0, method, max_rows, too_wide, LocalStep(), false);
+      if (st.acting_.empty()) {
+        // δ starts at the first switch, located on y_u.
+        const event_detail::SearchResult& first = st.locator_.find_first_crossing(
+            outside_.poly, outside_.start, 1.0, outside_.settings);
+        st.diagnostics_.gap_samples += first.samples;
+        if (!first.found) {
+          changed_.clear();
+          done = finish_local(LocalStep(), false);
+        } else {
+          sigma_ = first.at.t;
+          outside_.springs_of(first, found_);
+        }
+      }
+      if (!done && !free_short_) {
+        bool wide = false;
+        done = local_pieces(t0, method, max_rows, &wide, LocalStep(), false);
+      }
     } catch (...) {
       discard_local();
       reset_free();
       throw;
     }
-    if (done) return FreeOutcome::done;
-    const bool short_window = free_short_;
-    if (short_window) free_terms_ = 0;
+    if (done) return true;
+    // Too wide, or beyond the windows, or a spring found on the wrong side at the end: the
+    // step is redone on the whole state's series, which decides for itself.
+    if (free_short_) free_terms_ = 0;
     reset_free();
-    return short_window ? FreeOutcome::fall_back : FreeOutcome::too_wide;
+    return false;
   }
 
   // Spring j's rows [lo, hi).
@@ -450,10 +453,7 @@ class LocalSwitchCorrection {
       record.first_toggles = found_;
       record.sources = changed_;
     }
-    if (sigma_ >= 1.0) {
-      finish_local(std::move(record), keep);
-      return true;
-    }
+    if (sigma_ >= 1.0) return finish_local(std::move(record), keep);
     add_changed_rows(support_);
 
     int guard = 0;
@@ -569,8 +569,7 @@ class LocalSwitchCorrection {
       pending_flips_.clear();
       add_changed_rows(support_);
     }
-    finish_local(std::move(record), keep);
-    return true;
+    return finish_local(std::move(record), keep);
   }
 
   // Everything a local step leaves in the buffers, dropped (after a throw).
@@ -587,19 +586,34 @@ class LocalSwitchCorrection {
     reset_source_rows();
   }
 
-  // The step's end y_u(η) + δ(η), its tangent, and the stepper's end of step.
-  void finish_local(LocalStep&& record, bool keep) {
+  // The step's end y_u(η) + δ(η), its tangent, and the stepper's end of step. False, with the
+  // step abandoned (abandon()), when a free motion step ends with a spring on the wrong side.
+  bool finish_local(LocalStep&& record, bool keep) {
     Stepper& st = me();
     if (free_base_) {
       st.free_motion_end(st.vx_, st.vu_);
+      support_.for_each_row([&](Index i) {
+        st.vx_[i] += dx_[0][i];
+        st.vu_[i] += du_[0][i];
+      });
+      // The springs the free motion's searches trusted to the first screen are checked at the
+      // end, as a smooth step's LCP checks them: one on the wrong side of its kink for its mode
+      // sends the step back (free_short_) to the whole state's series, which searches them all.
+      if (!st.modes_hold(st.vx_)) {
+        free_short_ = true;
+        abandon();
+        return false;
+      }
       ++st.diagnostics_.free_windowed;
       reset_free();
     } else {
       st.evaluate_series(terms_u_, 1.0);
+      support_.for_each_row([&](Index i) {
+        st.vx_[i] += dx_[0][i];
+        st.vu_[i] += du_[0][i];
+      });
     }
     support_.for_each_row([&](Index i) {
-      st.vx_[i] += dx_[0][i];
-      st.vu_[i] += du_[0][i];
       dx_[0][i] = 0.0;
       du_[0][i] = 0.0;
     });
@@ -634,6 +648,7 @@ class LocalSwitchCorrection {
     changed_.clear();
     reset_source_rows();
     st.finish_step();
+    return true;
   }
 
   // A located switch of spring j (counted), and the list of springs whose mode differs from m0.

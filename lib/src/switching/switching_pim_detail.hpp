@@ -158,15 +158,15 @@ struct CandidateSprings {
   Vector rest_;  // scratch of select()
 
   // From the polynomials of every spring (row j is spring j), or, with `names`, of some springs
-  // of a set of `total`: row k of `all` is spring names[k] (ascending), and springs and row_of
-  // speak of the whole set.
+  // of a set of `total` (possibly none): row k of `all` is spring (*names)[k] (ascending), and
+  // springs and row_of speak of the whole set.
   void select(const PolynomialGaps& all, const event_detail::SearchSettings& all_settings,
-              const Index* names = nullptr, Index total = 0) {
+              const std::vector<Index>* names = nullptr, Index total = 0) {
     const Matrix& c = all.c;
     const Index m = c.rows(), R = c.cols() - 1;
     springs.clear();
     row_of.assign(static_cast<std::size_t>(names == nullptr ? m : total), -1);
-    const auto name = [&](Index j) { return names == nullptr ? j : names[j]; };
+    const auto name = [&](Index j) { return names == nullptr ? j : (*names)[static_cast<std::size_t>(j)]; };
     // S_j = Σ_{r>=2} |c(j, r)| column by column (contiguous; the same sums in the same order).
     rest_.setZero(m);
     for (Index r = 2; r <= R; ++r) rest_ += c.col(r).cwiseAbs();

@@ -105,11 +105,15 @@ struct BandedSwitchingPimOptions {
   // The three agree to rounding.
   enum class SwitchCorrection { automatic, local, whole_state };
   SwitchCorrection switch_correction = SwitchCorrection::automatic;
-  // A locally corrected step that starts with no spring touching takes the motion without its
-  // switches from the smooth step's T y (exact then: there is no spring force to approximate)
-  // and that motion's gap polynomials from its series on windows of rows around the springs the
-  // gap screen left, instead of from the series of the whole state. false: the whole state's
-  // series, as every other switching step (the two agree to rounding).
+  // A locally corrected step takes the motion its correction is added to as the free motion
+  // (every spring open; the springs touching at the start become sources of the correction):
+  // its end from T y (exact: no spring force to approximate) and its gap polynomials from its
+  // series on windows of rows around the springs the gap screen left and the touching ones,
+  // instead of the start mode's series on the whole state. Where the windows cannot decide the
+  // step it goes to the whole state's series (local_switch_correction.hpp). false: always the
+  // whole state's series. The two agree to rounding, not to the bit; advance_with_tangent and a
+  // recording advance_to always take the whole state's series, so with this on they agree with a
+  // plain advance_to to rounding.
   bool windowed_free_motion = true;
   // Ceres-style check: false with a message naming the field (pim.step, band.tolerance, ...)
   // and its value.
