@@ -261,11 +261,23 @@ class LocalSwitchCorrection {
   // every spring open, its end T y from the stepper (free_motion_end), its gap polynomials from
   // its series on windows of rows around the springs the step's gap screen left and the springs
   // touching at the start (the stepper's window_series), and those touching springs are sources
-  // of δ from the start on. fall_back, having changed nothing, when that cannot decide the step alone: no
-  // spring left by the screen (an LCP mismatch), windows over a quarter of the rows, a window's
-  // series that does not converge, a spring on its kink that must switch at the start, or a
-  // correction that reaches springs beyond the windows' exact rows.
+  // of δ from the start on. False, with the modes and buffers of the step's start, when that
+  // cannot decide the step alone: no spring left by the screen (an LCP mismatch), windows over a
+  // quarter of the rows, a window's series that does not converge, a spring on its kink that
+  // must switch at the start, a correction too wide or reaching springs beyond the windows'
+  // exact rows, or a spring on the wrong side of its kink at the end. The searches' samples and
+  // halved pieces of such an attempt stay counted in the diagnostics (work done).
   bool free_motion_step(double t0, const char* method, Index max_rows) {
+    try {
+      return free_motion_attempt(t0, method, max_rows);
+    } catch (...) {
+      // Nothing of the attempt may outlive it (free_row_'s marks, δ's rows).
+      discard_local();
+      reset_free();
+      throw;
+    }
+  }
+  bool free_motion_attempt(double t0, const char* method, Index max_rows) {
     Stepper& st = me();
     const int max_terms = st.o_.max_series_terms;
     free_springs_.clear();
@@ -359,6 +371,7 @@ class LocalSwitchCorrection {
     }
     free_base_ = true;
     free_short_ = false;
+    free_rejected_ = false;
     free_start_mode_ = st.mode_;
     local_switches_ = 0;
     local_pieces_ = 0;
@@ -371,32 +384,26 @@ class LocalSwitchCorrection {
     sigma_ = 0.0;
     ensure_terms(max_terms);
     bool done = false;
-    try {
-      if (st.acting_.empty()) {
-        // δ starts at the first switch, located on y_u.
-        const event_detail::SearchResult& first = st.locator_.find_first_crossing(
-            outside_.poly, outside_.start, 1.0, outside_.settings);
-        st.diagnostics_.gap_samples += first.samples;
-        if (!first.found) {
-          changed_.clear();
-          done = finish_local(LocalStep(), false);
-        } else {
-          sigma_ = first.at.t;
-          outside_.springs_of(first, found_);
-        }
+    if (st.acting_.empty()) {
+      // δ starts at the first switch, located on y_u.
+      const event_detail::SearchResult& first = st.locator_.find_first_crossing(
+          outside_.poly, outside_.start, 1.0, outside_.settings);
+      st.diagnostics_.gap_samples += first.samples;
+      if (!first.found) {
+        changed_.clear();
+        done = finish_local(LocalStep(), false);
+      } else {
+        sigma_ = first.at.t;
+        outside_.springs_of(first, found_);
       }
-      if (!done && !free_short_) {
-        bool wide = false;
-        done = local_pieces(t0, method, max_rows, &wide, LocalStep(), false);
-      }
-    } catch (...) {
-      discard_local();
-      reset_free();
-      throw;
+    }
+    if (!done && !free_rejected_) {
+      bool wide = false;
+      done = local_pieces(t0, method, max_rows, &wide, LocalStep(), false);
     }
     if (done) return true;
-    // Too wide, or beyond the windows, or a spring found on the wrong side at the end: the
-    // step is redone on the whole state's series, which decides for itself.
+    // Too wide, beyond the windows (the next windows start again from max_series_terms), or a
+    // spring on the wrong side at the end: the whole state's series decides the step.
     if (free_short_) free_terms_ = 0;
     reset_free();
     return false;
@@ -432,6 +439,7 @@ class LocalSwitchCorrection {
     free_rows_.clear();
     free_base_ = false;
     free_short_ = false;
+    free_rejected_ = false;
   }
 
   // The pieces of local_switching_step from its first switch (found_, at sigma_).
@@ -598,9 +606,9 @@ class LocalSwitchCorrection {
       });
       // The springs the free motion's searches trusted to the first screen are checked at the
       // end, as a smooth step's LCP checks them: one on the wrong side of its kink for its mode
-      // sends the step back (free_short_) to the whole state's series, which searches them all.
+      // sends the step back (free_rejected_) to the whole state's series, which searches them all.
       if (!st.modes_hold(st.vx_)) {
-        free_short_ = true;
+        free_rejected_ = true;
         abandon();
         return false;
       }
@@ -1007,7 +1015,7 @@ class LocalSwitchCorrection {
   // A free motion step: the springs the screen left, the windows, the series, the springs within
   // them (free_named_) with their rows in free_gaps_ (free_row_: -1 none, -2 not exact), and
   // the polynomials and search settings of the springs the screen left.
-  bool free_base_ = false, free_short_ = false;
+  bool free_base_ = false, free_short_ = false, free_rejected_ = false;
   int free_terms_ = 0;  // the windows' K; 0: max_series_terms
   Vector free_start_mode_;
   std::vector<Index> free_springs_, free_named_;
