@@ -617,6 +617,15 @@ class BandedStepper final : public SwitchingPim,
     damping_band_.multiply_add(u.data(), acc.data());
     if (forces) force_band_.multiply_add(p.data(), acc.data());
   }
+  // The rows [lo, hi) spring j's gap reads (empty for a spring without rows).
+  std::pair<Index, Index> spring_span(Index j) const {
+    Index lo = n_, hi = 0;
+    for (RowSparse::InnerIterator it(gap_rows_, j); it; ++it) {
+      lo = std::min(lo, it.col());
+      hi = std::max(hi, it.col() + 1);
+    }
+    return {lo, hi};
+  }
   // (W^T x)_j: spring j's stretch in the displacement x, from its sparse row. x is read by row
   // index (a whole-state Vector, or the local corrections' terms).
   template <class Rows>
@@ -654,10 +663,10 @@ class BandedStepper final : public SwitchingPim,
   // `windows` only, with the whole state's banded stencils restricted to them. The r-th term
   // couples rows at most r · reach apart (K, C and the springs' two ends), so on a window it is
   // exactly the whole state's term on the rows at least r · reach from an edge of the window
-  // that is not an end of the structure; each term is computed there only, from the exact rows
-  // of the term before. (A touching spring's force is read only by rows next to its own, so it
-  // is exact where it is read.) After each term r, record(w, r, x_r, first, last) for each
-  // window w, x_r whole-size and exact on its rows [first, last). Stops once two consecutive
+  // that is not an end of the structure (window_exact_rows); each term is computed there only,
+  // from the exact rows of the term before. (A touching spring's force is read only by rows next
+  // to its own, so it is exact where it is read.) After each term r, record(r, x_r): x_r
+  // whole-size, exact on the windows' exact rows of term r. Stops once two consecutive
   // terms are below ε/2 of the largest entry seen (at least `scale`; the result in *largest),
   // measured on the exact rows, not before 4 terms: a stopping rule of the same kind as the
   // whole state's (ModeSeries::taylor), not a bound. Returns the last term's index, or -1 when K
@@ -687,21 +696,14 @@ class BandedStepper final : public SwitchingPim,
       free_scale_[g] = 1.0;
     }
     const auto& ranges = windows.ranges();
-    const auto first_row = [&](std::size_t w, int r) {
-      const Index lo = ranges[w].first, hi = ranges[w].second;
-      return lo > 0 ? std::min<Index>(hi, lo + r * reach_) : lo;
-    };
-    const auto last_row = [&](std::size_t w, int r) {
-      const Index hi = ranges[w].second;
-      return hi < n_ ? std::max<Index>(first_row(w, r), hi - r * reach_) : hi;
-    };
     const Vector* x = &xs_[0];
     const Vector* u = &us_[0];
+    record(0, *x);
     double size = 0.0;
-    for (std::size_t w = 0; w < ranges.size(); ++w) {
-      const Index a = first_row(w, 0), b = last_row(w, 0);
-      record(w, 0, *x, a, b);
-      for (Index i = a; i < b; ++i) size = std::max({size, std::abs((*x)[i]), std::abs((*u)[i])});
+    for (const switching_detail::RowRanges::Range& range : ranges) {
+      for (Index i = range.first; i < range.second; ++i) {
+        size = std::max({size, std::abs((*x)[i]), std::abs((*u)[i])});
+      }
     }
     double big = std::max(scale, size), previous = size;
     for (int r = 0; r < K; ++r) {
@@ -717,8 +719,8 @@ class BandedStepper final : public SwitchingPim,
           free_force_[j] = r == 0 ? force - spring_offset_[j] : force;
         }
       }
-      for (std::size_t w = 0; w < ranges.size(); ++w) {
-        const Index a = first_row(w, r + 1), b = last_row(w, r + 1);
+      for (const switching_detail::RowRanges::Range& range : ranges) {
+        const auto [a, b] = window_exact_rows(range, r + 1);
         stiffness_band_.multiply(x->data(), free_acc_.data(), a, b);
         damping_band_.multiply_add(u->data(), free_acc_.data(), a, b);
         if (forces) force_band_.multiply_add(free_force_.data(), free_acc_.data(), a, b);
@@ -737,8 +739,8 @@ class BandedStepper final : public SwitchingPim,
           u1[i] = f * free_acc_[i];
           size = std::max({size, std::abs(x1[i]), std::abs(u1[i])});
         }
-        record(w, r + 1, x1, a, b);
       }
+      record(r + 1, x1);
       for (std::size_t g = 0; g < groups; ++g) free_scale_[g] *= loads_[g].omega * eta_ / (r + 1);
       x = &x1;
       u = &u1;
@@ -748,6 +750,15 @@ class BandedStepper final : public SwitchingPim,
       previous = size;
     }
     return -1;
+  }
+  // The rows of a window on which window_series' term r is exact: those at least r reaches from
+  // an edge that is not an end of the structure.
+  std::pair<Index, Index> window_exact_rows(const switching_detail::RowRanges::Range& window,
+                                            int r) const {
+    const auto [lo, hi] = window;
+    const Index first = lo > 0 ? std::min<Index>(hi, lo + r * reach_) : lo;
+    const Index last = hi < n_ ? std::max<Index>(first, hi - r * reach_) : hi;
+    return {first, last};
   }
   // True when every spring's gap in the displacement x is on its mode's side of the kink (within
   // the kink tolerance): the check a smooth step's LCP makes at its end.

@@ -41,7 +41,7 @@
 namespace pwl::switching_detail {
 
 // CRTP mixin of the banded switching stepper (a friend of it, whose ModeSeries buffers and search
-// it uses): the stepper provides reach_, n_, m_, o_, signs_, gaps_, gap_rows_, spring_stretch,
+// it uses): the stepper provides reach_, n_, m_, o_, signs_, gaps_, spring_span, spring_stretch,
 // window_series (the Taylor series on windows of rows) and the first screen's terms.
 template <class Stepper>
 class LocalGapScreen {
@@ -57,18 +57,12 @@ class LocalGapScreen {
     const int K = window_terms_ > 0 ? std::min(most, window_terms_) : most;
     const Index margin = static_cast<Index>(K) * st.reach_;
     screen_springs_.clear();
-    spring_lows_.clear();
     screen_ranges_.clear();
     for (Index j = 0; j < st.m_; ++j) {
       if (st.screen_clears(j)) continue;
-      Index lo = st.n_, hi = 0;
-      for (typename Stepper::RowSparseMatrix::InnerIterator it(st.gap_rows_, j); it; ++it) {
-        lo = std::min(lo, it.col());
-        hi = std::max(hi, it.col() + 1);
-      }
+      const auto [lo, hi] = st.spring_span(j);
       if (lo >= hi) return false;  // a spring without rows: nothing to window
       screen_springs_.push_back(j);
-      spring_lows_.push_back(lo);
       screen_ranges_.add(std::max<Index>(0, lo - margin), std::min(st.n_, hi + margin));
     }
     if (screen_springs_.empty()) return true;
@@ -78,34 +72,15 @@ class LocalGapScreen {
     const auto count = static_cast<Index>(screen_springs_.size());
     const auto stride = static_cast<std::size_t>(K + 1);
     screen_coefficients_.assign(static_cast<std::size_t>(count) * stride, 0.0);
-    // Each window's screened springs (in its middle: exact up to term K), as entries of
-    // screen_springs_ grouped by window.
-    const auto& windows = screen_ranges_.ranges();
-    window_first_.assign(windows.size() + 1, 0);
-    window_of_.resize(screen_springs_.size());
-    for (std::size_t i = 0; i < screen_springs_.size(); ++i) {
-      const Index row = spring_lows_[i];
-      const auto it = std::upper_bound(windows.begin(), windows.end(), row,
-                                       [](Index v, const RowRanges::Range& range) { return v < range.first; });
-      window_of_[i] = static_cast<std::size_t>(it - windows.begin()) - 1;
-      ++window_first_[window_of_[i] + 1];
-    }
-    for (std::size_t w = 0; w < windows.size(); ++w) window_first_[w + 1] += window_first_[w];
-    by_window_.resize(screen_springs_.size());
-    {
-      std::vector<std::size_t>& next = window_next_;
-      next.assign(window_first_.begin(), window_first_.end() - 1);
-      for (std::size_t i = 0; i < screen_springs_.size(); ++i) by_window_[next[window_of_[i]]++] = i;
-    }
+    // The screened springs lie in their windows' middles: exact up to term K.
     double largest = 0.0;
-    const int longest = st.window_series(
-        t, screen_ranges_, K, 0.0, false, &largest,
-        [&](std::size_t w, int r, const Vector& x, Index, Index) {
-          for (std::size_t p = window_first_[w]; p < window_first_[w + 1]; ++p) {
-            const std::size_t i = by_window_[p];
-            screen_coefficients_[i * stride + static_cast<std::size_t>(r)] = st.spring_stretch(screen_springs_[i], x);
-          }
-        });
+    const int longest = st.window_series(t, screen_ranges_, K, 0.0, false, &largest,
+                                         [&](int r, const Vector& x) {
+                                           for (std::size_t i = 0; i < screen_springs_.size(); ++i) {
+                                             screen_coefficients_[i * stride + static_cast<std::size_t>(r)] =
+                                                 st.spring_stretch(screen_springs_[i], x);
+                                           }
+                                         });
     if (longest < 0) {
       window_terms_ = 0;
       return false;
@@ -133,10 +108,6 @@ class LocalGapScreen {
  private:
   int window_terms_ = 0;  // the windows' K; 0: max_series_terms
   std::vector<Index> screen_springs_;  // the springs the first screen left, ascending
-  std::vector<Index> spring_lows_;      // their first rows
-  // The screened springs grouped by window: by_window_[window_first_[w] ..] are the entries of
-  // screen_springs_ in window w (window_of_ each one's window; window_next_ scratch).
-  std::vector<std::size_t> window_first_, window_of_, by_window_, window_next_;
   RowRanges screen_ranges_;            // their windows
   std::vector<double> screen_coefficients_;
   PolynomialGaps screen_poly_;

@@ -147,7 +147,8 @@ inline void shift_polynomial(const double* a, int R, double sigma0, double rho, 
 // CRTP mixin of the banded switching stepper (a friend of it, as of ModeSeries, whose series
 // buffers, search and tangent it uses). The stepper provides reach_ (see above), its sparse parts
 // stiffness_part_, damping_part_, force_part_ (row-major) and gap_rows_, the members ModeSeries
-// names, and for the free motion free_windows_, acting_, window_series and free_motion_end.
+// names, and for the free motion free_windows_, acting_, spring_span, window_series,
+// window_exact_rows, modes_hold and free_motion_end.
 template <class Stepper>
 class LocalSwitchCorrection {
  protected:
@@ -297,7 +298,7 @@ class LocalSwitchCorrection {
     const Index margin = 2 * static_cast<Index>(K) * st.reach_;
     free_ranges_.clear();
     const auto add_window = [&](Index j) {
-      const auto [lo, hi] = spring_rows(j);
+      const auto [lo, hi] = st.spring_span(j);
       free_ranges_.add(std::max<Index>(0, lo - margin), std::min(st.n_, hi + margin));
     };
     for (Index j : free_springs_) add_window(j);
@@ -311,8 +312,8 @@ class LocalSwitchCorrection {
       scale = std::max(scale, st.xs_[ru].cwiseAbs().maxCoeff());
       if (r <= st.d_) scale = std::max(scale, st.us_[ru].cwiseAbs().maxCoeff());
     }
-    // The gap coefficients of every spring within a window, exact where the spring's rows are
-    // among the term's exact rows; those exact up to the last term are kept.
+    // The gap coefficients of every spring within a window; kept for the springs whose rows are
+    // among their window's exact rows of the last term.
     const auto stride = static_cast<std::size_t>(max_terms + 1);
     const auto& windows = free_ranges_.ranges();
     free_first_.clear();
@@ -324,30 +325,28 @@ class LocalSwitchCorrection {
           if (free_row_[static_cast<std::size_t>(j)] != -1) continue;
           free_row_[static_cast<std::size_t>(j)] = static_cast<int>(free_named_.size());
           free_named_.push_back(j);
-          free_rows_.push_back(spring_rows(j));
         }
       }
     }
     free_first_.push_back(free_named_.size());
     free_gaps_.assign(free_named_.size() * stride, 0.0);
-    exact_.assign(free_named_.size(), 0);
-    const int R = st.window_series(
-        t0, free_ranges_, K, scale, true, &scale,
-        [&](std::size_t w, int r, const Vector& x, Index first, Index last) {
-          for (std::size_t k = free_first_[w]; k < free_first_[w + 1]; ++k) {
-            const bool exact = free_rows_[k].first >= first && free_rows_[k].second <= last;
-            exact_[k] = exact ? 1 : 0;
-            if (exact) free_gaps_[k * stride + static_cast<std::size_t>(r)] = st.spring_stretch(free_named_[k], x);
-          }
-        });
+    const int R = st.window_series(t0, free_ranges_, K, scale, true, &scale, [&](int r, const Vector& x) {
+      for (std::size_t k = 0; k < free_named_.size(); ++k) {
+        free_gaps_[k * stride + static_cast<std::size_t>(r)] = st.spring_stretch(free_named_[k], x);
+      }
+    });
     if (R < 0) {
       free_terms_ = 0;
       reset_free();
       return false;
     }
     free_terms_ = std::max(R + 4, K - 1);
-    for (std::size_t k = 0; k < free_named_.size(); ++k) {
-      if (!exact_[k]) free_row_[static_cast<std::size_t>(free_named_[k])] = -2;
+    for (std::size_t w = 0; w < windows.size(); ++w) {
+      const auto [first, last] = st.window_exact_rows(windows[w], R);
+      for (std::size_t k = free_first_[w]; k < free_first_[w + 1]; ++k) {
+        const auto [lo, hi] = st.spring_span(free_named_[k]);
+        if (lo < first || hi > last) free_row_[static_cast<std::size_t>(free_named_[k])] = -2;
+      }
     }
     // The open springs the screen left: on their kinks first, then the searches on y_u alone.
     const auto count = static_cast<Index>(free_springs_.size());
@@ -409,17 +408,6 @@ class LocalSwitchCorrection {
     return false;
   }
 
-  // Spring j's rows [lo, hi).
-  std::pair<Index, Index> spring_rows(Index j) const {
-    const Stepper& st = static_cast<const Stepper&>(*this);
-    Index lo = st.n_, hi = 0;
-    for (typename Stepper::RowSparseMatrix::InnerIterator it(st.gap_rows_, j); it; ++it) {
-      lo = std::min(lo, it.col());
-      hi = std::max(hi, it.col() + 1);
-    }
-    return {lo, hi};
-  }
-
   // y_u's scaled gap coefficient r of spring j: the whole state's series, or, in a free motion
   // step, the windows' (a spring beyond their exact rows marks the step short and reads 0).
   double u_gap(int r, Index j) {
@@ -436,7 +424,6 @@ class LocalSwitchCorrection {
   void reset_free() {
     for (Index j : free_named_) free_row_[static_cast<std::size_t>(j)] = -1;
     free_named_.clear();
-    free_rows_.clear();
     free_base_ = false;
     free_short_ = false;
     free_rejected_ = false;
@@ -1020,9 +1007,7 @@ class LocalSwitchCorrection {
   Vector free_start_mode_;
   std::vector<Index> free_springs_, free_named_;
   std::vector<int> free_row_;
-  std::vector<std::pair<Index, Index>> free_rows_;  // the rows of free_named_'s springs
   std::vector<std::size_t> free_first_;  // the first of free_named_ in each window, and the end
-  std::vector<char> exact_;
   std::vector<double> free_gaps_;
   RowRanges free_ranges_;
   PolynomialGaps free_poly_;
