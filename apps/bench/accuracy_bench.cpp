@@ -92,6 +92,55 @@ double log_slope(const std::vector<double>& x, const std::vector<double>& y) {
   return (n * sxy - sx * sy) / (n * sxx - sx * sx);
 }
 
+CheapestPoint cheapest_reaching(const std::vector<WorkCurve>& family, double error) {
+  CheapestPoint best;
+  for (std::size_t c = 0; c < family.size(); ++c) {
+    for (std::size_t i = 0; i < family[c].size(); ++i) {
+      const WorkPoint& p = family[c][i];
+      if (!(p.error <= error) || !(p.seconds < best.seconds)) continue;
+      best.curve = static_cast<int>(c);
+      best.point = static_cast<int>(i);
+      best.seconds = p.seconds;
+    }
+  }
+  return best;
+}
+
+CostComparison compare_cost_to_reach(const std::vector<WorkCurve>& ours,
+                                     const std::vector<WorkCurve>& theirs, double lo, double hi) {
+  if (!(lo > 0.0) || !(lo <= hi) || !std::isfinite(hi)) {
+    throw InputError(fmt::format("cost to reach: the errors lo = {} and hi = {} must satisfy "
+                                 "0 < lo <= hi",
+                                 lo, hi));
+  }
+  // The errors where either family's cost can change inside [lo, hi], with hi itself (the cost
+  // on [e, next) is the cost at e, and below the lowest of them down to lo the cost at lo).
+  std::vector<double> levels{hi, lo};
+  for (const std::vector<WorkCurve>* family : {&ours, &theirs}) {
+    for (const WorkCurve& curve : *family) {
+      for (const WorkPoint& p : curve) {
+        if (p.error >= lo && p.error <= hi) levels.push_back(p.error);
+      }
+    }
+  }
+  std::sort(levels.begin(), levels.end(), std::greater<>());
+  CostComparison result;
+  result.ours_cheaper_everywhere = true;
+  for (double level : levels) {
+    const CheapestPoint a = cheapest_reaching(ours, level);
+    const CheapestPoint b = cheapest_reaching(theirs, level);
+    const double ratio = !a.found()   ? 0.0
+                         : !b.found() ? std::numeric_limits<double>::infinity()
+                                      : b.seconds / a.seconds;
+    if (!(ratio > 1.0)) result.ours_cheaper_everywhere = false;
+    if (std::isnan(result.narrowest_ratio) || ratio < result.narrowest_ratio) {
+      result.narrowest_ratio = ratio;
+      result.narrowest_error = level;
+    }
+  }
+  return result;
+}
+
 }  // namespace accuracy_detail
 
 namespace {
@@ -124,6 +173,7 @@ struct Curve {
   std::string label;    // for the table
   std::string parameter_name;
   bool fixed_step = false;
+  bool runge_kutta = false;  // a Runge-Kutta curve (the rivals); otherwise one of pwl's methods
   std::vector<Point> points;
 };
 
@@ -164,6 +214,14 @@ double work_slope(const Curve& c, double floor) {
   return -accuracy_detail::log_slope(seconds, errors);
 }
 
+// A point's parameter as the tables print it.
+std::string parameter_text(const Curve& c, const Point& p) {
+  return c.parameter_name == "steps/period" ? fmt::format("η = T/{:g}", p.parameter)
+         : c.parameter_name == "steps/s"    ? fmt::format("η = 1/{:g} s", p.parameter)
+         : c.parameter_name == "tol"        ? fmt::format("tol {:.0e}", p.parameter)
+                                            : std::string("-");
+}
+
 void print_table(const std::string& title, const std::vector<Curve>& curves, double floor) {
   fmt::print("\n{}\n", title);
   fmt::print("| method | parameter | CPU time (median) | error | steps | measured order | "
@@ -177,11 +235,7 @@ void print_table(const std::string& title, const std::vector<Curve>& curves, dou
     const double slope = work_slope(c, floor);
     for (std::size_t i = 0; i < c.points.size(); ++i) {
       const Point& p = c.points[i];
-      const std::string parameter =
-          c.parameter_name == "steps/period" ? fmt::format("η = T/{:g}", p.parameter)
-          : c.parameter_name == "steps/s"    ? fmt::format("η = 1/{:g} s", p.parameter)
-          : c.parameter_name == "tol"        ? fmt::format("tol {:.0e}", p.parameter)
-                                             : std::string("-");
+      const std::string parameter = parameter_text(c, p);
       const std::string order_text = i == 0 ? number(order) : std::string();
       const std::string slope_text = i == 0 ? number(slope) : std::string();
       if (!p.run.ok) {
@@ -199,6 +253,67 @@ void print_table(const std::string& title, const std::vector<Curve>& curves, dou
              "adaptive ones the steps include those that land on kinks, so it is not their "
              "nominal order). s: the same against CPU time.\n",
              floor);
+}
+
+// The cost-to-reach table (accuracy_detail::compare_cost_to_reach): at each decade of error from
+// 1e-1 down to the floor, the cheapest pwl point and the cheapest Runge-Kutta point at or below
+// it, and whether pwl is the cheaper at every error from 1e-3 down to the floor (not below 1e-10),
+// checked at every measured point's error in between, not only at the decades.
+void print_cost_to_reach(const std::vector<Curve>& curves, double floor) {
+  std::vector<const Curve*> pwl_curves, rk_curves;
+  std::vector<accuracy_detail::WorkCurve> pwl_work, rk_work;
+  for (const Curve& c : curves) {
+    accuracy_detail::WorkCurve work;
+    for (const Point& p : c.points) {
+      if (p.run.ok && std::isfinite(p.run.error)) work.push_back({p.run.median_seconds, p.run.error});
+    }
+    (c.runge_kutta ? rk_curves : pwl_curves).push_back(&c);
+    (c.runge_kutta ? rk_work : pwl_work).push_back(std::move(work));
+  }
+  // The curve's point behind a work point (failed points were left out of the work curves).
+  const auto describe = [](const Curve& c, int index) {
+    int seen = 0;
+    for (const Point& p : c.points) {
+      if (!p.run.ok || !std::isfinite(p.run.error)) continue;
+      if (seen++ == index) {
+        return fmt::format("{}, {} ({:.1e})", c.label, parameter_text(c, p), p.run.error);
+      }
+    }
+    return std::string("?");
+  };
+  fmt::print("\nCost to reach an error: the cheapest point at or below it (CPU time, median)\n");
+  fmt::print("| error <= | cheapest pwl point | CPU time | cheapest Runge-Kutta point | CPU time | "
+             "Runge-Kutta / pwl |\n");
+  fmt::print("| --- | --- | --- | --- | --- | --- |\n");
+  for (int e = 1; std::pow(10.0, -e) >= floor * (1 - 1e-9); ++e) {
+    const double level = std::pow(10.0, -e);
+    const auto a = accuracy_detail::cheapest_reaching(pwl_work, level);
+    const auto b = accuracy_detail::cheapest_reaching(rk_work, level);
+    const auto name = [&](const std::vector<const Curve*>& family,
+                          const accuracy_detail::CheapestPoint& p) {
+      return p.found() ? describe(*family[p.curve], p.point) : std::string("none");
+    };
+    const auto time = [](const accuracy_detail::CheapestPoint& p) {
+      return p.found() ? fmt::format("{:.4g} s", p.seconds) : std::string("-");
+    };
+    fmt::print("| {:.0e} | {} | {} | {} | {} | {} |\n", level, name(pwl_curves, a), time(a),
+               name(rk_curves, b), time(b),
+               a.found() && b.found() ? fmt::format("{:.2f}", b.seconds / a.seconds)
+                                      : std::string("-"));
+  }
+  const double hi = 1e-3;
+  const double lo = std::min(hi, std::max(floor, 1e-10));
+  const auto verdict = accuracy_detail::compare_cost_to_reach(pwl_work, rk_work, lo, hi);
+  const std::string margin =
+      verdict.narrowest_ratio == 0.0 ? fmt::format("no pwl point is at or below {:.2e}",
+                                                   verdict.narrowest_error)
+      : std::isinf(verdict.narrowest_ratio)
+          ? fmt::format("no Runge-Kutta point is at or below {:.2e}", verdict.narrowest_error)
+          : fmt::format("Runge-Kutta / pwl = {:.2f} at {:.2e}", verdict.narrowest_ratio,
+                        verdict.narrowest_error);
+  fmt::print("pwl cheaper than every Runge-Kutta curve at every error from {:.0e} to {:.0e}: {} "
+             "(narrowest: {})\n",
+             hi, lo, verdict.ours_cheaper_everywhere ? "yes" : "no", margin);
 }
 
 std::vector<double> tolerances(bool quick, double tightest) {
@@ -238,6 +353,7 @@ void runge_kutta_curves(const GapStructure& s, const std::vector<double>& tols,
       c.key = fmt::format("{}{}", row.name, kinks ? "-kinks" : "");
       c.label = fmt::format("{}{}", row.name, kinks ? " kink-located" : "");
       c.parameter_name = "tol";
+      c.runge_kutta = true;
       for (double tol : tols) {
         MethodSettings settings;
         settings.method = row.method;
@@ -347,6 +463,7 @@ void five_dof(const AccuracyOptions& o) {
                           "the {} Poincaré points against the exact event-driven solver",
                           periods),
               curves, 1e-11);
+  print_cost_to_reach(curves, 1e-11);
   plot(o, "4a", curves,
        fmt::format("Figure 4a (5 DOF, α = 2, ζ = 0.2, θ = 1): {} periods from rest", periods),
        "largest error of the Poincaré states x, x′ (nondimensional)");
@@ -418,6 +535,7 @@ void large_chain(const AccuracyOptions& o) {
                           "every whole second against rkf78 kink-located at tolerance {:g} ({:.3g} s)",
                           o.chain_masses, t_end, o.chain_truth_tolerance, truth_run.median_seconds),
               curves, 100 * o.chain_truth_tolerance);
+  print_cost_to_reach(curves, 100 * o.chain_truth_tolerance);
   plot(o, "chain", curves,
        fmt::format("Chain n = {} (m = 1 kg, k1 = k2 = 1 N/m, c = 0.2 N s/m): t in [0, {}] s",
                    o.chain_masses, t_end),

@@ -21,6 +21,7 @@
 // exponential is part of its cost), medians of repeated runs.
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -63,6 +64,37 @@ Run measure(const Factory& make, const std::vector<double>& times,
 // Least-squares slope of log y against log x over the pairs with both positive and finite.
 // NaN with fewer than two such pairs.
 double log_slope(const std::vector<double>& x, const std::vector<double>& y);
+
+// Cost to reach an error, from a work-precision diagram. A curve's cost to reach an error e is
+// the CPU time of its cheapest point whose error is at or below e: nothing is interpolated
+// between points, so nothing is claimed that was not measured. The cost of a family of curves
+// (pwl's methods, or the Runge-Kutta ones) is the least over its curves. It is a step function of
+// e that changes only at the points' errors, so two families compared at e = lo and at every
+// point's error inside [lo, hi] are compared at every e in [lo, hi], not only at the decades.
+struct WorkPoint {
+  double seconds = 0.0;
+  double error = 0.0;
+};
+using WorkCurve = std::vector<WorkPoint>;  // the points that ran (a failed point is left out)
+
+struct CheapestPoint {
+  int curve = -1;  // -1: no point of the family is at or below the error
+  int point = -1;
+  double seconds = std::numeric_limits<double>::infinity();
+  bool found() const { return curve >= 0; }
+};
+CheapestPoint cheapest_reaching(const std::vector<WorkCurve>& family, double error);
+
+struct CostComparison {
+  bool ours_cheaper_everywhere = false;  // strictly, at every error in [lo, hi]
+  // Where theirs / ours is least over [lo, hi] (the first such error from hi down), and that
+  // ratio: infinity where theirs reaches no point, 0 where ours reaches none.
+  double narrowest_error = std::numeric_limits<double>::quiet_NaN();
+  double narrowest_ratio = std::numeric_limits<double>::quiet_NaN();
+};
+// Throws InputError unless 0 < lo <= hi.
+CostComparison compare_cost_to_reach(const std::vector<WorkCurve>& ours,
+                                     const std::vector<WorkCurve>& theirs, double lo, double hi);
 
 // The stability bench (accuracy_stability.cpp).
 void add_stability_bench(CLI::App& bench);
