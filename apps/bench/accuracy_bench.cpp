@@ -302,7 +302,13 @@ void print_cost_to_reach(const std::vector<Curve>& curves, double floor) {
                                       : std::string("-"));
   }
   const double hi = 1e-3;
-  const double lo = std::min(hi, std::max(floor, 1e-10));
+  if (floor > hi) {
+    fmt::print("pwl against the Runge-Kutta curves from 1e-03 down: not judged (the truth's floor "
+               "{:.0e} is above 1e-03)\n",
+               floor);
+    return;
+  }
+  const double lo = std::max(floor, 1e-10);
   const auto verdict = accuracy_detail::compare_cost_to_reach(pwl_work, rk_work, lo, hi);
   const std::string margin =
       verdict.narrowest_ratio == 0.0 ? fmt::format("no pwl point is at or below {:.2e}",

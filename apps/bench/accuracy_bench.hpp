@@ -8,7 +8,9 @@
 //    n = 1000 chain, where the exact solver does not apply (2^1000 modes), from the tightest
 //    kink-located rkf78, at every whole second. Curves: the paper's PIM over η, the switching
 //    (higher-order) PIM over η, dopri5 and rkf78 over tolerances, plain and kink-located, and
-//    the exact solver. One CSV per curve, a PNG per case, a table with the measured order.
+//    the exact solver. One CSV per curve, a PNG per case, a table with the measured order, and a
+//    table of the cost to reach each decade of error (pwl's cheapest point against the
+//    Runge-Kutta methods' cheapest) with the verdict over 1e-3 to 1e-10 (compare_cost_to_reach).
 //  - stability: the contact stiffness ratio α = k2/k1 from 1 to 10^6 against the step (or the
 //    tolerance) on the 5-DOF chain of figure 4a: for each method, where it blows up, is refused
 //    (a step its own checks reject), misses contacts (sees fewer than 95% of the exact solver's
