@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <Eigen/LU>
+#include <omp.h>
 
 #include "pwl/integrators/banded_pim_integrator.hpp"
 #include "pwl/integrators/banded_switching_pim.hpp"
@@ -848,4 +849,34 @@ TEST_CASE("banded switching PIM: local corrections with stiff contacts halve the
   CHECK(da.switches > 10);
   CHECK(largest > 0.01);
   CHECK(worst < 1e-13 * largest);
+}
+
+TEST_CASE("banded switching PIM: construction on one thread or two, the same bits, and the "
+          "caller's thread count restored",
+          "[banded][switching][threads]") {
+  // The construction keeps its small substructures' products on the calling thread
+  // (lib/src/numerics/serial_products.hpp) by setting that thread's OpenMP thread count to one
+  // for a while: it must give it back, also when the construction throws, and the operators must
+  // not depend on how many threads there were.
+  const GapStructure s = make_chain(paper_large_chain(120));
+  const int caller = omp_get_max_threads();
+  const auto run = [&](int threads) {
+    omp_set_num_threads(threads);
+    auto pim = make_banded_switching_pim(s, banded_options(0.4));
+    CHECK(omp_get_max_threads() == threads);
+    const Vector rest = Vector::Zero(s.dofs());
+    pim->set_state(0.0, rest, rest);
+    Vector x;
+    pim->advance_to(8.0, [&x](double, const Vector& a, const Vector&) { x = a; });
+    return x;
+  };
+  const Vector one = run(1);
+  const Vector two = run(2);
+  CHECK(one.cwiseNotEqual(two).count() == 0);
+  omp_set_num_threads(3);
+  BandedSwitchingPimOptions bad = banded_options(0.4);
+  bad.band.max_band = 2;  // no band that small meets the tolerance: the probe throws
+  CHECK_THROWS_AS(make_banded_switching_pim(s, bad), InputError);
+  CHECK(omp_get_max_threads() == 3);
+  omp_set_num_threads(caller);
 }
