@@ -2,9 +2,10 @@
 // large: wide windows are where Eigen would split an exponential's products over the threads if
 // asked outside a parallel region, and where the rounding of a substructure then depends on which
 // other blocks share its chunk of the assembly (one of 256 blocks in the long chain's last chunk,
-// several in the short chain's only chunk). The banded exponential computes every substructure
-// inside a parallel region, so the long chain's laid-out operators are still those built row by
-// row, bit for bit, on two threads. Release only: the row-by-row build of 4000 masses with
+// several in the short chain's only chunk). The banded exponential keeps every substructure's
+// products on one thread (inside a parallel region over the substructures, or, where they are too
+// few to pay for one, on the calling thread with Eigen told so: serial_products.hpp), so the long
+// chain's laid-out operators are still those built row by row, bit for bit, on two threads. Release only: the row-by-row build of 4000 masses with
 // 180-mass substructures takes seconds.
 #include <omp.h>
 
