@@ -66,10 +66,20 @@ TEST_CASE("cost to reach: one family below another over a range, at every error 
     const std::vector<WorkCurve> theirs{{{2.0, 1e-4}}};
     CHECK_FALSE(compare_cost_to_reach(ours, theirs, 1e-4, 1e-3).ours_cheaper_everywhere);
   }
+  SECTION("a point whose error is not a number reaches nothing") {
+    const std::vector<WorkCurve> ours{{{1.0, std::nan("")}, {2.0, 1e-4}}};
+    const std::vector<WorkCurve> theirs{{{3.0, 1e-4}}};
+    CHECK(cheapest_reaching(ours, 1.0).seconds == 2.0);
+    const auto c = compare_cost_to_reach(ours, theirs, 1e-4, 1e-3);
+    CHECK(c.ours_cheaper_everywhere);
+    CHECK(c.narrowest_ratio == Approx(1.5));
+  }
   SECTION("a range that is not one is refused") {
     const std::vector<WorkCurve> one{{{1.0, 1e-3}}};
     CHECK_THROWS_AS(compare_cost_to_reach(one, one, 1e-3, 1e-4), pwl::InputError);
     CHECK_THROWS_AS(compare_cost_to_reach(one, one, 0.0, 1e-4), pwl::InputError);
     CHECK_THROWS_AS(compare_cost_to_reach(one, one, std::nan(""), 1e-4), pwl::InputError);
+    CHECK_THROWS_AS(compare_cost_to_reach(one, one, 1e-4, std::numeric_limits<double>::infinity()),
+                    pwl::InputError);
   }
 }

@@ -286,23 +286,24 @@ Assembly assemble(const GapStructure& s, double step, const std::vector<LoadGrou
       out.largest = std::max(out.largest, block.window_last - block.window_first);
     }
     std::exception_ptr error;
-    // Each exponential's products stay on one thread (SerialProducts here, or the parallel region
-    // below, inside which Eigen does not split them). Split over the threads, a large window's
-    // products would round their partial sums differently, and a substructure's bits would depend
-    // on which other blocks share its chunk (construction from the period relies on them not
-    // depending on that). The substructures themselves go over the threads only when there is
-    // work enough to pay for it: after a parallel region the idle threads spin before they sleep,
-    // about 8 ms of CPU time here, where a periodic chain's few substructures (5 of 22 degrees of
-    // freedom on the 1000-mass chain at η = 0.4 s) take 1.7 ms on one thread and 1.6 ms on two.
-    const numerics_detail::SerialProducts serial;
+    // Each exponential's products stay on the thread that computes it (a SerialProducts in the
+    // loop's body: inside a team Eigen would not split them anyway, but a nested or inactive
+    // region hands its tasks the next entry of an OMP_NUM_THREADS list such as 2,2, and Eigen
+    // would split again). Split over the threads, a wide window's products would round their
+    // partial sums differently, and a substructure's bits would depend on which other blocks
+    // share its chunk (construction from the period relies on them not depending on that). The
+    // substructures themselves go over the threads only when there is work enough to pay for a
+    // parallel region: after one the idle threads spin before they sleep, about 8 ms of CPU time
+    // here, where a periodic chain's few substructures (5 of 22 degrees of freedom on the
+    // 1000-mass chain at η = 0.4 s) take 1.7 ms on one thread and 1.6 ms on two. Without that
+    // work no region is opened at all.
     double work = 0.0;  // the products' multiply-adds, up to a constant: Σ (2w)³
     for (const auto& [entry, block] : missing) {
       const auto w = static_cast<double>(block->window_last - block->window_first);
       work += 8.0 * w * w * w;
     }
-    const bool spread = missing.size() > 1 && work >= kSpreadWork;
-#pragma omp parallel for schedule(dynamic) num_threads(serial.saved_threads()) if (spread)
-    for (std::size_t k = 0; k < missing.size(); ++k) {
+    const auto compute = [&](std::size_t k) {
+      const numerics_detail::SerialProducts serial;
       try {
         const RowBlock& block = *missing[k].second;
         missing[k].first->e = std::make_shared<const SubstructureExponential>(
@@ -312,6 +313,12 @@ Assembly assemble(const GapStructure& s, double step, const std::vector<LoadGrou
 #pragma omp critical
         if (!error) error = std::current_exception();
       }
+    };
+    if (missing.size() > 1 && work >= kSpreadWork) {
+#pragma omp parallel for schedule(dynamic)
+      for (std::size_t k = 0; k < missing.size(); ++k) compute(k);
+    } else {
+      for (std::size_t k = 0; k < missing.size(); ++k) compute(k);
     }
     if (error) std::rethrow_exception(error);
     out.exponentials += static_cast<Index>(missing.size());
