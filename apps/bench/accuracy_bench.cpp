@@ -260,44 +260,44 @@ void print_table(const std::string& title, const std::vector<Curve>& curves, dou
 // it, and whether pwl is the cheaper at every error from 1e-3 down to the floor (not below 1e-10),
 // checked at every measured point's error in between, not only at the decades.
 void print_cost_to_reach(const std::vector<Curve>& curves, double floor) {
-  std::vector<const Curve*> pwl_curves, rk_curves;
-  std::vector<accuracy_detail::WorkCurve> pwl_work, rk_work;
+  // Each family's work curves (the points that ran, with a finite error) and, index for index,
+  // the curve and point behind each work point.
+  struct Family {
+    std::vector<accuracy_detail::WorkCurve> work;
+    std::vector<const Curve*> curves;
+    std::vector<std::vector<const Point*>> points;
+  };
+  Family pwl, rk;
   for (const Curve& c : curves) {
-    accuracy_detail::WorkCurve work;
-    for (const Point& p : c.points) {
-      if (p.run.ok && std::isfinite(p.run.error)) work.push_back({p.run.median_seconds, p.run.error});
-    }
-    (c.runge_kutta ? rk_curves : pwl_curves).push_back(&c);
-    (c.runge_kutta ? rk_work : pwl_work).push_back(std::move(work));
-  }
-  // The curve's point behind a work point (failed points were left out of the work curves).
-  const auto describe = [](const Curve& c, int index) {
-    int seen = 0;
+    Family& f = c.runge_kutta ? rk : pwl;
+    f.curves.push_back(&c);
+    f.work.emplace_back();
+    f.points.emplace_back();
     for (const Point& p : c.points) {
       if (!p.run.ok || !std::isfinite(p.run.error)) continue;
-      if (seen++ == index) {
-        return fmt::format("{}, {} ({:.1e})", c.label, parameter_text(c, p), p.run.error);
-      }
+      f.work.back().push_back({p.run.median_seconds, p.run.error});
+      f.points.back().push_back(&p);
     }
-    return std::string("?");
-  };
+  }
   fmt::print("\nCost to reach an error: the cheapest point at or below it (CPU time, median)\n");
   fmt::print("| error <= | cheapest pwl point | CPU time | cheapest Runge-Kutta point | CPU time | "
              "Runge-Kutta / pwl |\n");
   fmt::print("| --- | --- | --- | --- | --- | --- |\n");
   for (int e = 1; std::pow(10.0, -e) >= floor * (1 - 1e-9); ++e) {
     const double level = std::pow(10.0, -e);
-    const auto a = accuracy_detail::cheapest_reaching(pwl_work, level);
-    const auto b = accuracy_detail::cheapest_reaching(rk_work, level);
-    const auto name = [&](const std::vector<const Curve*>& family,
-                          const accuracy_detail::CheapestPoint& p) {
-      return p.found() ? describe(*family[p.curve], p.point) : std::string("none");
+    const auto a = accuracy_detail::cheapest_reaching(pwl.work, level);
+    const auto b = accuracy_detail::cheapest_reaching(rk.work, level);
+    const auto name = [](const Family& f, const accuracy_detail::CheapestPoint& p) {
+      if (!p.found()) return std::string("none");
+      const Curve& c = *f.curves[static_cast<std::size_t>(p.curve)];
+      const Point& q = *f.points[static_cast<std::size_t>(p.curve)][static_cast<std::size_t>(p.point)];
+      return fmt::format("{}, {} ({:.1e})", c.label, parameter_text(c, q), q.run.error);
     };
     const auto time = [](const accuracy_detail::CheapestPoint& p) {
       return p.found() ? fmt::format("{:.4g} s", p.seconds) : std::string("-");
     };
-    fmt::print("| {:.0e} | {} | {} | {} | {} | {} |\n", level, name(pwl_curves, a), time(a),
-               name(rk_curves, b), time(b),
+    fmt::print("| {:.0e} | {} | {} | {} | {} | {} |\n", level, name(pwl, a), time(a),
+               name(rk, b), time(b),
                a.found() && b.found() ? fmt::format("{:.2f}", b.seconds / a.seconds)
                                       : std::string("-"));
   }
@@ -309,7 +309,7 @@ void print_cost_to_reach(const std::vector<Curve>& curves, double floor) {
     return;
   }
   const double lo = std::max(floor, 1e-10);
-  const auto verdict = accuracy_detail::compare_cost_to_reach(pwl_work, rk_work, lo, hi);
+  const auto verdict = accuracy_detail::compare_cost_to_reach(pwl.work, rk.work, lo, hi);
   const std::string margin =
       verdict.narrowest_ratio == 0.0 ? fmt::format("no pwl point is at or below {:.2e}",
                                                    verdict.narrowest_error)

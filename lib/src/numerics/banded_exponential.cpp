@@ -342,7 +342,7 @@ Index probe_margin(const GapStructure& s, double step, const BandedExponentialOp
     // T alone: the load integrals fall off faster, and the assembly checks them anyway.
     const Index w = last - first, li = mid - first;
     *reach = R;
-    const numerics_detail::SerialProducts serial(2 * w < numerics_detail::kSerialProductRows);
+    const auto serial = numerics_detail::SerialProducts::for_rows(2 * w);
     const Matrix T = precise_exponential(substructure_state_matrix(s, first, last), step,
                                          o.exponential);
     Profiles p(4, R);

@@ -34,6 +34,8 @@ class SerialProducts {
   ~SerialProducts() {
     if (active_) omp_set_num_threads(saved_);
   }
+  // Active for products of fewer than kSerialProductRows rows, the policy in one place.
+  static SerialProducts for_rows(long rows) { return SerialProducts(rows < kSerialProductRows); }
   SerialProducts(const SerialProducts&) = delete;
   SerialProducts& operator=(const SerialProducts&) = delete;
 

@@ -109,7 +109,7 @@ std::vector<BandedMatrix> banded_force_coefficients(const GapStructure& s, doubl
       const Matrix H = substructure_state_matrix(s, block.window_first, block.window_last);
       Matrix G = Matrix::Zero(2 * w, w);
       G.bottomRows(w).setIdentity();
-      const numerics_detail::SerialProducts serial(2 * w < numerics_detail::kSerialProductRows);
+      const auto serial = numerics_detail::SerialProducts::for_rows(2 * w);
       const PolynomialForceIntegrals pfi =
           polynomial_force_integrals(H, eta, G, d + (end ? 2 : 1), o.exponential);
       ForceCoefficients c = force_coefficients(pfi.moments, d, end);
