@@ -289,8 +289,9 @@ void print_cost_to_reach(const std::vector<Curve>& curves, double floor) {
     const auto b = accuracy_detail::cheapest_reaching(rk.work, level);
     const auto name = [](const Family& f, const accuracy_detail::CheapestPoint& p) {
       if (!p.found()) return std::string("none");
-      const Curve& c = *f.curves[static_cast<std::size_t>(p.curve)];
-      const Point& q = *f.points[static_cast<std::size_t>(p.curve)][static_cast<std::size_t>(p.point)];
+      const auto curve = static_cast<std::size_t>(p.curve);
+      const Point& q = *f.points[curve][static_cast<std::size_t>(p.point)];
+      const Curve& c = *f.curves[curve];
       return fmt::format("{}, {} ({:.1e})", c.label, parameter_text(c, q), q.run.error);
     };
     const auto time = [](const accuracy_detail::CheapestPoint& p) {

@@ -5,8 +5,8 @@
 // several in the short chain's only chunk). The banded exponential keeps every substructure's
 // products on one thread (inside a parallel region over the substructures, or, where they are too
 // few to pay for one, on the calling thread with Eigen told so: serial_products.hpp), so the long
-// chain's laid-out operators are still those built row by row, bit for bit, on two threads. Release only: the row-by-row build of 4000 masses with
-// 180-mass substructures takes seconds.
+// chain's laid-out operators are still those built row by row, bit for bit, on two threads.
+// Release only: the row-by-row build of 4000 masses with 180-mass substructures takes seconds.
 #include <omp.h>
 
 #include <catch2/catch.hpp>
