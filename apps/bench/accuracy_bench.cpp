@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <limits>
 
+#include "bench/bench_clock.hpp"
 #include "commands/cli_checks.hpp"
 #include "output/csv_writer.hpp"
 #include "output/gnuplot.hpp"
@@ -19,12 +20,6 @@
 
 namespace pwl::app {
 namespace accuracy_detail {
-
-double cpu_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
 
 Run measure(const Factory& make, const std::vector<double>& times,
             const std::vector<Vector>& truth, int repeats, double budget) {

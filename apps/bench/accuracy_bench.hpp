@@ -38,9 +38,6 @@ void add_accuracy_benches(CLI::App& bench);
 
 namespace accuracy_detail {
 
-// CPU time of the process in seconds.
-double cpu_seconds();
-
 // A method under test: builds a fresh integrator at rest at t = 0.
 using Factory = std::function<std::unique_ptr<Integrator>()>;
 

@@ -13,6 +13,7 @@
 
 #include <fmt/format.h>
 
+#include "bench/bench_clock.hpp"
 #include "output/csv_writer.hpp"
 #include "pwl/errors.hpp"
 #include "pwl/integrators/accuracy_step.hpp"
@@ -23,18 +24,6 @@
 
 namespace pwl::app {
 namespace {
-
-double cpu_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 // A row of the benchmark: its key, label and parameters (those of the committed tables), the
 // method table's settings it runs, and whether it is the base the others are compared with. Its

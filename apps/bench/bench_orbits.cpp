@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_clock.hpp"
 #include "commands/cli_checks.hpp"
 #include "pwl/errors.hpp"
 #include "pwl/integrators/method_table.hpp"
@@ -57,18 +58,6 @@ const std::vector<std::string>& case_keys() {
   return keys;
 }
 
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-// CPU time of the process (all threads): on a machine shared with other jobs the wall clock also
-// counts the time spent waiting for a core.
-double cpu_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
 // Wall and CPU time of one run.
 struct Stopwatch {
   Clock::time_point wall = Clock::now();
@@ -76,13 +65,6 @@ struct Stopwatch {
   double wall_seconds() const { return seconds_since(wall); }
   double cpu_seconds_since() const { return cpu_seconds() - cpu; }
 };
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 double inf_norm(const Vector& v) { return v.size() == 0 ? 0.0 : v.lpNorm<Eigen::Infinity>(); }
 

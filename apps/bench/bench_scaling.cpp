@@ -15,6 +15,7 @@
 #include <fmt/format.h>
 #include <omp.h>
 
+#include "bench/bench_clock.hpp"
 #include "pwl/integrators/banded_propagator.hpp"
 #include "pwl/model/chain_builders.hpp"
 #include "pwl/errors.hpp"
@@ -25,20 +26,6 @@ namespace pwl::app {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-// CPU time of this thread: on a machine shared with other jobs, the wall clock also counts the
-// time the thread waited for a core.
-double thread_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
 
 // Median over repeats of the CPU time per call of `body`, called `calls` times per repeat.
 template <class Body>

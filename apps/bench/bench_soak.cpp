@@ -26,7 +26,9 @@
 #include <thread>
 #include <vector>
 
+#include "bench/bench_clock.hpp"
 #include "commands/cli_checks.hpp"
+#include "commands/flag_relations.hpp"
 #include "pwl/errors.hpp"
 #include "pwl/study/sweep_journal.hpp"
 
@@ -50,10 +52,6 @@ struct SoakOptions {
   std::string out = "soak";
   bool quiet = false;
 };
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 std::vector<std::string> sweep_arguments(const SoakOptions& o, const fs::path& folder,
                                          bool resume) {
@@ -177,6 +175,7 @@ struct Attempt {
 };
 
 void run(const SoakOptions& o) {
+  check_relation("bench soak", "--min-delay", o.min_delay, "--max-delay", o.max_delay);
   const std::string self = fs::read_symlink("/proc/self/exe").string();
   const fs::path out(o.out), whole = out / "whole", killed = out / "killed", logs = out / "logs";
   fs::remove_all(whole);

@@ -12,6 +12,7 @@
 #include <memory>
 #include <vector>
 
+#include "bench/bench_clock.hpp"
 #include "commands/cli_checks.hpp"
 #include "pwl/study/parameter_grid.hpp"
 #include "pwl/study/parameter_sweep.hpp"
@@ -36,16 +37,6 @@ struct SweepBenchOptions {
   std::string out = "plots/data";
   bool quiet = false;
 };
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 analysis::SweepOptions sweep_of(const SweepBenchOptions& o) {
   analysis::SweepOptions s;

@@ -1,4 +1,4 @@
-// pwl: dynamics of piecewise-linear structures. See README.md for the jobs it does.
+// pwl: dynamics of piecewise-linear structures. apps/README.md says what each job does.
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>

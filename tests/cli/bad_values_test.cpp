@@ -12,6 +12,11 @@
 // so that a new kind of value is classified rather than skipped. The sign and range rows are
 // chosen per flag (a gap or a load has none).
 //
+// Relations between two flags (a smallest step at most the largest, a second parameter other than
+// the first: apps/pwl/commands/flag_relations.hpp) are rows of the same table, whose flag field
+// names both flags and whose value field gives both values, separated by a space
+// ("--min-step --max-step" and "0.5 0.1"); every relation of the program's table must have one.
+//
 // Each row then runs the real program (PWL_EXECUTABLE) in a folder of its own with a time limit,
 // several at once: a value that slips through is a run that exits 0, fails for another reason, or
 // is killed at the limit, and the row fails with what the program said.
@@ -38,6 +43,7 @@
 
 #include "commands/cli_checks.hpp"
 #include "commands/commands.hpp"
+#include "commands/flag_relations.hpp"
 #include "scene/scene_command_line.hpp"
 
 namespace fs = std::filesystem;
@@ -121,6 +127,12 @@ struct Row {
   std::string value;
   std::string message;
   int line = 0;  // in bad_values.csv
+
+  // One flag and its value, or the two of a relation (space-separated in both fields).
+  std::vector<std::string> flags() const { return words(flag); }
+  std::vector<std::string> values() const {
+    return flags().size() == 1 ? std::vector<std::string>{value} : words(value);
+  }
 };
 
 // One CSV line: fields separated by commas, a field in double quotes may hold commas and "" for a
@@ -240,14 +252,14 @@ const std::map<std::string, std::vector<std::string>>& base_arguments() {
   return base;
 }
 
-// The base arguments of `job` in folder `dir`, without the flag `except` and its value.
+// The base arguments of `job` in folder `dir`, without the flags `except` and their values.
 std::vector<std::string> base_of(const std::string& job, const std::string& dir,
-                                 const std::string& except) {
+                                 const std::vector<std::string>& except) {
   std::vector<std::string> out;
   const std::vector<std::string>& base = base_arguments().at(job);
   for (std::size_t i = 0; i < base.size(); ++i) {
     const bool takes_value = i + 1 < base.size() && base[i + 1].rfind("--", 0) != 0;
-    if (base[i] == except) {
+    if (std::find(except.begin(), except.end(), base[i]) != except.end()) {
       if (takes_value) ++i;
       continue;
     }
@@ -500,9 +512,28 @@ TEST_CASE("Every numeric flag of every job has its bad values in the table", "[b
   CHECK(missing == 0);
   // No row for a job or flag that does not exist (a row left behind by a renamed flag).
   for (const Row& row : table()) {
-    if (known.count({row.job, row.flag}) == 0) {
-      FAIL_CHECK("bad_values.csv:" << row.line << ": pwl " << row.job << " has no flag "
-                                   << row.flag);
+    const std::vector<std::string> flags = row.flags();
+    for (const std::string& flag : flags) {
+      if (known.count({row.job, flag}) == 0) {
+        FAIL_CHECK("bad_values.csv:" << row.line << ": pwl " << row.job << " has no flag "
+                                     << flag);
+      }
+    }
+    if (flags.size() > 2 || flags.size() != row.values().size()) {
+      FAIL_CHECK("bad_values.csv:" << row.line << ": give one flag and its value, or the two "
+                                      "flags of a relation and their two values");
+    }
+  }
+  // Every relation between two flags has its row.
+  for (const pwl::app::FlagRelation& relation : pwl::app::flag_relations()) {
+    const std::string flags = relation.first + " " + relation.second;
+    const bool has_row = std::any_of(table().begin(), table().end(), [&](const Row& row) {
+      return row.job == relation.job && row.flag == flags;
+    });
+    if (!has_row) {
+      FAIL_CHECK("pwl " << relation.job << ": the relation between " << relation.first << " and "
+                        << relation.second << " (flag_relations.cpp) has no row \"" << flags
+                        << "\" in tests/cli/bad_values.csv");
     }
   }
   // And every job with rows has its base arguments.
@@ -522,10 +553,11 @@ TEST_CASE("Every bad value of the table is refused on the command line", "[bad-v
     Run run;
     run.dir = fresh_folder("flag_" + std::to_string(index++));
     run.args = words(row.job);
-    const std::vector<std::string> base = base_of(row.job, run.dir, row.flag);
+    const std::vector<std::string> flags = row.flags(), values = row.values();
+    const std::vector<std::string> base = base_of(row.job, run.dir, flags);
     run.args.insert(run.args.end(), base.begin(), base.end());
     // --flag=value: a value starting with '-' is the flag's value, not another flag.
-    run.args.push_back(row.flag + "=" + row.value);
+    for (std::size_t k = 0; k < flags.size(); ++k) run.args.push_back(flags[k] + "=" + values[k]);
     run.what = row_name(row);
     run.expected = {row.message};
     runs.push_back(std::move(run));
@@ -554,19 +586,39 @@ TEST_CASE("Every bad value of the table is refused as a scene key, located in th
   int index = 0;
   for (const Row& row : rows_to_run()) {
     if (base_arguments().count(row.job) == 0 || by_name.count(row.job) == 0) continue;
-    const CLI::Option* option = by_name[row.job]->get_option_no_throw(row.flag);
-    if (option == nullptr || option->get_group().empty()) continue;  // hidden: no scene key
+    const std::vector<std::string> flags = row.flags(), values = row.values();
+    const bool hidden = std::any_of(flags.begin(), flags.end(), [&](const auto& f) {
+      const CLI::Option* option = by_name[row.job]->get_option_no_throw(f);
+      return option == nullptr || option->get_group().empty();
+    });
+    if (hidden) continue;  // a hidden flag has no scene key
     Run run;
     run.dir = fresh_folder("scene_" + std::to_string(index++));
-    std::string key = row.flag.substr(2);
-    std::replace(key.begin(), key.end(), '-', '_');
+    const auto key_of = [](const std::string& flag) {
+      std::string key = flag.substr(2);
+      std::replace(key.begin(), key.end(), '-', '_');
+      return key;
+    };
+    const std::string key = key_of(flags.front());
     const std::string scene = run.dir + "/bad.toml";
-    std::ofstream(scene) << "job = \"" << row.job << "\"\n[run]\n"
-                         << key << " = " << toml_value(row.value) << "\n";
+    {
+      std::ofstream file(scene);
+      file << "job = \"" << row.job << "\"\n[run]\n";
+      for (std::size_t k = 0; k < flags.size(); ++k) {
+        file << key_of(flags[k]) << " = " << toml_value(values[k]) << "\n";
+      }
+    }
     run.args = {"run", scene};
-    const std::vector<std::string> base = base_of(row.job, run.dir, row.flag);
+    const std::vector<std::string> base = base_of(row.job, run.dir, flags);
     run.args.insert(run.args.end(), base.begin(), base.end());
     run.what = row_name(row) + " as the scene key run." + key;
+    if (flags.size() > 1) {
+      // A relation: refused once both keys are read, with the table's message and the scene's
+      // file (the pair has no single line).
+      run.expected = {scene, row.message};
+      runs.push_back(std::move(run));
+      continue;
+    }
     const std::vector<std::string> parts = items(row.value);
     const auto non_finite = std::find_if(parts.begin(), parts.end(), [](const std::string& p) {
       return is_number(p) && !std::isfinite(std::strtod(p.c_str(), nullptr));

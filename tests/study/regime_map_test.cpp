@@ -44,7 +44,7 @@ TEST_CASE("a map cell is the sweep point of the same parameters", "[regime_map]"
       o.tasks(), [&](long id) { return o.chain_of(id); }, o.start_state(), o.point, {},
       [&](long id, const PointResult& r) { cells.emplace(id, r); }, {2});
   REQUIRE(cells.size() == 6);
-  // Cell (θ = 1, α = 2) is figure 4a's case: period-2 (README, checked against dopri5).
+  // Cell (θ = 1, α = 2) is figure 4a's case: period-2 (plots/README.md, checked against dopri5).
   CHECK(cells.at(1).regime == "period-2");
   CHECK(cells.at(1).lambda1 < 0.0);
   CHECK(cells.at(1).poincare.empty());

@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "commands/cli_checks.hpp"
+#include "commands/flag_relations.hpp"
 #include "commands/commands.hpp"
 #include "commands/study_flag_checks.hpp"
 #include "output/gnuplot.hpp"
@@ -109,10 +110,8 @@ analysis::BasinMapOptions basin_options(const BasinFlags& f) {
   parse_range("--y-range", f.y_range, &o.second.from, &o.second.to);
   check_finite_range("--y-range", f.y_range, o.second.from, o.second.to, f.y_points);
   o.second.points = f.y_points;
-  if (o.first.component == o.second.component) {
-    throw InputError(fmt::format("--x {} and --y {}: give two different state components", f.x,
-                                 f.y));
-  }
+  check_relation("basin", "--y", analysis::component_name(o.second.component, dofs), "--x",
+                 analysis::component_name(o.first.component, dofs));
   if (f.point.starts != 1) {
     throw InputError(fmt::format("--starts {}: a basin map starts every cell from its own state "
                                  "(the grid); give 1",
@@ -125,10 +124,7 @@ analysis::BasinMapOptions basin_options(const BasinFlags& f) {
                                  "on the last points of each motion)",
                                  f.kept_points));
   }
-  if (f.kept_points > f.point.periods) {
-    throw InputError(fmt::format("--kept-points {}: more than the --periods {} recorded",
-                                 f.kept_points, f.point.periods));
-  }
+  check_relation("basin", "--kept-points", f.kept_points, "--periods", f.point.periods);
   o.matching.periodic_tolerance = f.periodic_tolerance;
   o.matching.cloud_factor = f.cloud_factor;
   if (!f.start.at_rest()) o.base_state = f.start.state(dofs);

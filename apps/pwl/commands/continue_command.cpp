@@ -20,11 +20,13 @@
 #include "commands/cli_checks.hpp"
 #include "commands/commands.hpp"
 #include "commands/continue_command.hpp"
+#include "commands/flag_relations.hpp"
 #include "commands/orbit_options.hpp"
 #include "commands/step_guard_report.hpp"
 #include "commands/study_runner.hpp"
 #include "commands/sweep_command.hpp"
 #include "output/gnuplot.hpp"
+#include "output/csv_writer.hpp"
 #include "pwl/errors.hpp"
 #include "pwl/orbits/continuation.hpp"
 #include "pwl/orbits/orbit_profile.hpp"
@@ -84,7 +86,6 @@ class FlushedCsv {
   std::string path_;
 };
 
-std::string number(double value) { return fmt::format("{:.17g}", value); }
 
 // Appends ",field" to a CSV row.
 void add_field(std::string& row, const std::string& field) {
@@ -139,10 +140,10 @@ class ContinueOutputs : public orbits::ContinuationObserver {
   void point(const orbits::BranchPoint& p) override {
     const orbits::PeriodicOrbit& orbit = p.orbit;
     const bool stable = orbit.stable();
-    std::string row = fmt::format("{},{},{},{},{}", p.branch, number(p.parameter), orbit.period,
-                                  stable ? 1 : 0, number(orbit.multipliers.largest_modulus()));
-    for (int i : dofs_) add_field(row, number(p.profile.amplitude(i)));
-    for (int i : dofs_) add_field(row, number(orbit.state(i)));
+    std::string row = fmt::format("{},{},{},{},{}", p.branch, full_precision(p.parameter), orbit.period,
+                                  stable ? 1 : 0, full_precision(orbit.multipliers.largest_modulus()));
+    for (int i : dofs_) add_field(row, full_precision(p.profile.amplitude(i)));
+    for (int i : dofs_) add_field(row, full_precision(orbit.state(i)));
     row += fmt::format(",{}", orbit.multipliers.unstable_count());
     branch_.row(row);
     // The k Poincaré points of a period-k orbit: its state and k - 1 returns of the map.
@@ -153,10 +154,10 @@ class ContinueOutputs : public orbits::ContinuationObserver {
         if (!map) map = map_at(p.parameter);
         y = map->advance(y, 1, j - 1);
       }
-      std::string s = fmt::format("{},{},{},{},{}", number(p.parameter), p.branch, orbit.period,
+      std::string s = fmt::format("{},{},{},{},{}", full_precision(p.parameter), p.branch, orbit.period,
                                   stable ? 1 : 0, j);
-      for (int i : dofs_) add_field(s, number(y(i)));
-      for (int i : dofs_) add_field(s, number(y(n_ + i)));
+      for (int i : dofs_) add_field(s, full_precision(y(i)));
+      for (int i : dofs_) add_field(s, full_precision(y(n_ + i)));
       section_.row(s);
     }
     ++points_;
@@ -208,13 +209,13 @@ class ContinueOutputs : public orbits::ContinuationObserver {
   std::string bifurcation_row(const orbits::Bifurcation& b) {
     const bool grazing = b.type == orbits::BifurcationType::grazing;
     std::string row = fmt::format("{},{},{},{},{}", orbits::bifurcation_name(b.type),
-                                  number(b.parameter), b.branch, b.period,
+                                  full_precision(b.parameter), b.branch, b.period,
                                   grazing ? fmt::format("{}", b.spring + 1) : std::string());
     if (grazing) {
       row += ",,,";
     } else {
-      row += fmt::format(",{},{},{}", number(b.multiplier.real()), number(b.multiplier.imag()),
-                         number(std::abs(b.multiplier)));
+      row += fmt::format(",{},{},{}", full_precision(b.multiplier.real()), full_precision(b.multiplier.imag()),
+                         full_precision(std::abs(b.multiplier)));
     }
     add_field(row, bifurcation_detail(b));
     // The amplitudes of the orbit there, for the figure's marks.
@@ -231,10 +232,10 @@ class ContinueOutputs : public orbits::ContinuationObserver {
     }
     const Vector& amplitude = amplitudes_.at(b.parameter);
     for (int i : dofs_) {
-      add_field(row, std::isfinite(amplitude(i)) ? number(amplitude(i)) : std::string());
+      add_field(row, std::isfinite(amplitude(i)) ? full_precision(amplitude(i)) : std::string());
     }
     // Its state at t = 0 mod T, one of its Poincaré points, for the marks over the diagram.
-    for (int i : dofs_) add_field(row, number(b.state(i)));
+    for (int i : dofs_) add_field(row, full_precision(b.state(i)));
     return row;
   }
 
@@ -498,6 +499,8 @@ ContinuationProblem continuation_problem(const ContinueFlags& f) {
                                    end, why));
     }
   }
+  check_relation("continue", "--min-step", f.min_step, "--max-step", f.max_step);
+  check_relation("continue", "--min-step", f.min_step, "--step", f.step);
   if (f.max_points < 2) throw InputError(fmt::format("--max-points = {} must be >= 2", f.max_points));
   if (f.over_sweep == 1) {
     throw InputError("--over-sweep = 1: a bifurcation diagram needs at least 2 values");

@@ -8,18 +8,18 @@
 #include <system_error>
 #include <vector>
 
+#include "output/csv_writer.hpp"
 #include "pwl/errors.hpp"
 
 namespace pwl::app {
 namespace {
 
-std::string number(double value) { return fmt::format("{:.17g}", value); }
 
 std::string rows(const Matrix& m) {
   std::string text = "[";
   for (Index i = 0; i < m.rows(); ++i) {
     text += i > 0 ? ",\n  [" : "[";
-    for (Index j = 0; j < m.cols(); ++j) text += (j > 0 ? ", " : "") + number(m(i, j));
+    for (Index j = 0; j < m.cols(); ++j) text += (j > 0 ? ", " : "") + full_precision(m(i, j));
     text += "]";
   }
   return text + "]";
@@ -39,14 +39,14 @@ std::string structure_scene_text(const GapStructure& g) {
     text += fmt::format("{}{{ mass = {}{}, direction = {}, stiffness = {}, gap = {} }}",
                         j > 0 ? ",\n  " : "", s.dof + 1,
                         s.other_dof >= 0 ? fmt::format(", other_mass = {}", s.other_dof + 1) : "",
-                        number(s.direction), number(s.stiffness), number(s.gap));
+                        full_precision(s.direction), full_precision(s.stiffness), full_precision(s.gap));
   }
   text += "]\nload = [";
   for (std::size_t j = 0; j < g.loads.size(); ++j) {
     const HarmonicLoad& l = g.loads[j];
     text += fmt::format("{}{{ mass = {}, amplitude = {}, omega = {}, phase = {} }}",
-                        j > 0 ? ",\n  " : "", l.dof + 1, number(l.amplitude), number(l.omega),
-                        number(l.phase));
+                        j > 0 ? ",\n  " : "", l.dof + 1, full_precision(l.amplitude), full_precision(l.omega),
+                        full_precision(l.phase));
   }
   return text + "]\n";
 }

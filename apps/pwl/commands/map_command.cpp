@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "commands/cli_checks.hpp"
+#include "commands/flag_relations.hpp"
 #include "commands/commands.hpp"
 #include "commands/study_flag_checks.hpp"
 #include "commands/map_command.hpp"
@@ -63,6 +64,7 @@ analysis::RegimeMapOptions map_options(const MapFlags& f) {
   check_range_ends(model, o.first.parameter, "--x-range", f.x_range, o.first.from, o.first.to);
   o.first.points = f.x_points;
   o.second.parameter = parse_model_parameter(model, "--y", f.y);
+  check_relation("map", "--y", o.second.parameter.name(), "--x", o.first.parameter.name());
   parse_range("--y-range", f.y_range, &o.second.from, &o.second.to);
   check_range_ends(model, o.second.parameter, "--y-range", f.y_range, o.second.from,
                    o.second.to);

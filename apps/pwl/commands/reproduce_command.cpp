@@ -135,16 +135,33 @@ void copy_figures(const ReproducedScene& s, const std::string& from, const std::
   }
 }
 
-void reproduce(const ReproduceOptions& o) {
-  const std::vector<ReproducedScene>& scenes = reproduced_scenes();
-  for (const std::string& key : o.only) {
-    if (std::none_of(scenes.begin(), scenes.end(), [&](const auto& s) { return s.key == key; })) {
-      std::vector<std::string> keys;
-      for (const ReproducedScene& s : scenes) keys.push_back(s.key);
-      throw InputError(
-          fmt::format("--only: unknown figure '{}' (expected {})", key, fmt::join(keys, ", ")));
+// The keys --only names, with "paper" (the paper's figures and table) and "studies" (pwl's own)
+// standing for their scenes. Throws InputError for a name that is neither a key nor a group.
+std::vector<std::string> only_keys(const std::vector<std::string>& only,
+                                   const std::vector<ReproducedScene>& scenes) {
+  std::vector<std::string> keys;
+  for (const std::string& name : only) {
+    if (name == "paper" || name == "studies") {
+      for (const ReproducedScene& s : scenes) {
+        if (s.paper == (name == "paper")) keys.push_back(s.key);
+      }
+      continue;
     }
+    if (std::none_of(scenes.begin(), scenes.end(), [&](const auto& s) { return s.key == name; })) {
+      std::vector<std::string> all;
+      for (const ReproducedScene& s : scenes) all.push_back(s.key);
+      throw InputError(fmt::format("--only: unknown figure '{}' (expected paper, studies, {})",
+                                   name, fmt::join(all, ", ")));
+    }
+    keys.push_back(name);
   }
+  return keys;
+}
+
+void reproduce(const ReproduceOptions& options) {
+  const std::vector<ReproducedScene>& scenes = reproduced_scenes();
+  ReproduceOptions o = options;
+  o.only = only_keys(options.only, scenes);
   const std::string plots = o.plots.empty() ? plots_directory() : o.plots;
   // A smoke run keeps its data, figures and report apart under data/quick, so that it never
   // replaces the committed figures nor the data of a full run.
@@ -161,8 +178,14 @@ void reproduce(const ReproduceOptions& o) {
               : "");
   std::string five_dof, regimes, chain, charts, bifurcations;
   int done = 0, wanted = 0;
+  // Seconds spent on the paper's scenes and on pwl's own studies, and how many of each ran.
+  double part_seconds[2] = {0.0, 0.0};
+  int part_scenes[2] = {0, 0};
+  int paper_wanted = 0;
   for (const ReproducedScene& s : scenes) {
-    wanted += o.only.empty() || std::count(o.only.begin(), o.only.end(), s.key) > 0;
+    const bool run = o.only.empty() || std::count(o.only.begin(), o.only.end(), s.key) > 0;
+    wanted += run;
+    paper_wanted += run && s.paper;
   }
   for (const ReproducedScene& s : scenes) {
     if (!o.only.empty() && std::count(o.only.begin(), o.only.end(), s.key) == 0) continue;
@@ -206,7 +229,7 @@ void reproduce(const ReproduceOptions& o) {
           "in x1: **{}** ({:.1f} times). Its speed claims, ode45 5.0 and 55.7 times slower than "
           "the PIM at 1e-5 and 1e-10, against dopri5 here (judged against half the paper's "
           "ratios; the wall times themselves vary from run to run and are in "
-          "data/paper_fig7-9_table1/bench_chain.md; the README, \"Long chains\", says why): "
+          "data/paper_fig7-9_table1/bench_chain.md; plots/README.md, \"Figures 7-9 and Table 1\", says why): "
           "**{}** at 1e-5, **{}** at 1e-10.\n",
           rk_x / pim_x >= 5.0 ? "holds" : "does not hold", rk_x / pim_x,
           rk_wall / pim_wall >= 2.5 ? "holds" : "does not hold",
@@ -222,7 +245,18 @@ void reproduce(const ReproduceOptions& o) {
       if (s.key == "continuation") bifurcations = bifurcation_table(out + "/bifurcations.csv");
     }
     fmt::print("  done in {:.1f} s\n", seconds);
+    part_seconds[s.paper ? 0 : 1] += seconds;
+    ++part_scenes[s.paper ? 0 : 1];
+    if (s.paper && part_scenes[0] == paper_wanted) {
+      fmt::print("the paper's figures and table: {} scene(s) in {:.1f} s, drawn in {}{}\n",
+                 part_scenes[0], part_seconds[0], figures,
+                 wanted > paper_wanted ? "; pwl's own studies follow (--only paper skips them)"
+                                       : "");
+    }
     std::fflush(stdout);
+  }
+  if (part_scenes[1] > 0) {
+    fmt::print("pwl's own studies: {} scene(s) in {:.1f} s\n", part_scenes[1], part_seconds[1]);
   }
   if (!five_dof.empty()) {
     report +=
@@ -274,13 +308,17 @@ void add_reproduce_command(CLI::App& app) {
       "reproduce",
       "Run every shipped scene of the paper's figures and table, draw them under plots/figures and\n"
       "report what matched the paper (plots/report.md)\n"
-      "Example: pwl reproduce              (the whole paper, about 30 s on 2 idle cores)\n"
+      "The paper's figures and table come first (about 30 s on 2 idle cores), pwl's own studies\n"
+      "after them (about 4 minutes); each is printed with its time.\n"
+      "Example: pwl reproduce\n"
+      "         pwl reproduce --only paper    (the paper's figures and table only)\n"
       "         pwl reproduce --only 4a,7-9\n"
       "         pwl reproduce --quick      (a smoke run in seconds; all it writes in plots/data/quick)");
   c->add_option("--plots", options->plots, "Plots folder: figures/, data/ and report.md (default: plots/)");
   c->add_flag("--quick", options->quick, "Short runs, for smoke tests");
   c->add_option("--only", options->only,
-                "Only these: 4a, 4b, 5, 6, 7-9, theta-sweep, theta-alpha-map, continuation, basins")
+                "Only these: 4a, 4b, 5, 6, 7-9 (or paper: all five), theta-sweep,\n"
+                "theta-alpha-map, continuation, basins (or studies: all four)")
       ->delimiter(',');
   c->callback([options] { reproduce(*options); });
 }

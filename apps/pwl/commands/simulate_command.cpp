@@ -10,6 +10,7 @@
 
 #include "commands/cli_checks.hpp"
 #include "commands/commands.hpp"
+#include "commands/flag_relations.hpp"
 #include "output/csv_writer.hpp"
 #include "output/gnuplot.hpp"
 #include "pwl/errors.hpp"
@@ -25,10 +26,8 @@ void check_recording(const SimulateOptions& options, Index n) {
       throw InputError(fmt::format("--record {}: masses are numbered 1..{}", r, n));
     }
   }
-  if (options.run.skip_periods >= options.run.periods) {
-    throw InputError(fmt::format("--skip-periods = {} leaves nothing of --periods = {}",
-                                 options.run.skip_periods, options.run.periods));
-  }
+  check_relation("simulate", "--skip-periods", options.run.skip_periods, "--periods",
+                 options.run.periods);
 }
 
 // The command line's sink: poincare.csv and, with --record, trajectory.csv, opened once the flags

@@ -541,7 +541,7 @@ std::string study_title(const analysis::PointModel& model, const analysis::Point
   if (!point.section.is_default()) {
     title += fmt::format("; section {}", point.section.label(model.dofs()));
   }
-  // The verdict's helpers, briefly (the README says what each does).
+  // The verdict's helpers, briefly (analysis/README.md, "How a verdict is reached", says what each does).
   if (point.evidence_periods > 0) title += fmt::format("; evidence +{}", point.evidence_periods);
   if (point.confirm != analysis::Confirmation::none) {
     title += point.confirm == analysis::Confirmation::uncertain ? ", exact check"

@@ -25,6 +25,8 @@ void CsvWriter::row(const std::vector<double>& values) {
   fmt::print(file_, "{:.17g}\n", fmt::join(values, ","));
 }
 
+std::string full_precision(double value) { return fmt::format("{:.17g}", value); }
+
 std::vector<std::string> state_columns(const std::string& first, Index n) {
   std::vector<std::string> columns{first};
   for (Index i = 1; i <= n; ++i) columns.push_back(fmt::format("x{}", i));

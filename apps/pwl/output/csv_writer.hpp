@@ -26,6 +26,9 @@ class CsvWriter {
   std::string path_;
 };
 
+// `value` with 17 significant digits: read back, the same double.
+std::string full_precision(double value);
+
 // "x1".."xn" followed by "v1".."vn".
 std::vector<std::string> state_columns(const std::string& first, Index n);
 

@@ -1,6 +1,6 @@
 #pragma once
 // The shipped scenes that `pwl reproduce` runs, each as a user would run it (`pwl run SCENE`), and
-// where each puts the figures the README shows. A scene's own output goes under
+// where each puts the figures the guides show (plots/README.md lists them). A scene's own output goes under
 // <plots>/data/<scene>; its figures are copied to <plots>/<name>.png and .svg.
 #include <string>
 #include <utility>
@@ -21,10 +21,13 @@ struct ReproducedScene {
   std::vector<std::string> quick;
   // (file written by the scene, name of the figure under plots/), without the extension.
   std::vector<std::pair<std::string, std::string>> figures;
+  // One of the paper's figures or its table (run first), or one of pwl's own studies.
+  bool paper = false;
 };
 
-// Every scene `pwl reproduce` runs, in order: the paper's figures and table, then the project's
-// own charts that need no timing (the benchmarks' charts are made by their bench_*.toml scenes).
+// Every scene `pwl reproduce` runs, in order: the paper's figures and table first (`paper`), then
+// the project's own charts that need no timing (the benchmarks' charts are made by their
+// bench_*.toml scenes).
 const std::vector<ReproducedScene>& reproduced_scenes();
 
 // Runs `scene` through this very program (`self`: its path), its output under `out`, with the

@@ -26,9 +26,9 @@ import pwl
 
 
 def compute(points):
-    sweep = pwl.sweep(figure="5", parameter="theta", range="0.6:3", points=points,
+    sweep = pwl.sweep(figure="5", parameter="theta", range=(0.6, 3), points=points,
                       mode="continuation", transient=200, periods=60, record=["x5"])
-    branch = pwl.continue_(figure="5", parameter="theta", range="0.6:3")
+    branch = pwl.continue_(figure="5", parameter="theta", range=(0.6, 3))
     first = branch.branch == 0  # the period-1 branch the continuation started on
     return {
         "theta": sweep.poincare_parameter,
@@ -102,8 +102,9 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="bifurcation_theta.png", help="the PNG to write")
     parser.add_argument("--points", type=int, default=120, help="values of θ in the sweep")
+    parser.add_argument("--small", action="store_true", help="40 values of θ, for a quick check")
     args = parser.parse_args()
-    data = compute(args.points)
+    data = compute(40 if args.small else args.points)
     found = data["bifurcations"]
     print("period-1 branch: {} points, {} stable; bifurcations: {}".format(
         len(data["stable"]), int(np.sum(data["stable"])),

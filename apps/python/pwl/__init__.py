@@ -3,11 +3,15 @@
 Every job of the pwl program is a function here, with the program's flags as keyword arguments,
 dashes written as underscores (``--skip-periods 10`` is ``skip_periods=10``); the names, defaults,
 checks and error messages are the program's own, since the module parses the keywords with the
-program's flag definitions. ``pwl <job> --help`` lists them. A value is written as on the command
-line: numbers, strings, True for a flag that is given (``locate_kinks=True``), a list for a comma
-separated list (``loads=[1, -1, 1, -1, 1]``); None leaves a flag out. The flags that only shape the
-program's files or printout (``out``, ``quiet``, ``no_plot``, ...) are not taken: the functions
-return NumPy arrays instead and write nothing.
+program's flag definitions. ``help(pwl.simulate)`` (or ``pwl <job> --help``) lists every keyword
+with its default and meaning. Values are Python values: numbers, strings, True for a flag that is
+given (``locate_kinks=True``), a list, tuple or NumPy array for a list of values (``loads=[1, -1, 1,
+-1, 1]``, ``x0=np.zeros(5)``), a pair for a range (``range=(0.5, 3)``, ``x_range=(0.5, 3)``), and a
+``Structure`` wherever a structure goes (``structure=S``, or ``structure_scene=S``); the command
+line's strings keep working (``range="0.5:3"``, ``loads="1,-1,1,-1,1"``). None leaves a flag out.
+The flags that only shape the program's files or printout (``out``, ``quiet``, ``no_plot``, ...)
+are not taken: the functions return NumPy arrays instead and write nothing. Every result prints
+as one line that says what it holds (``repr``).
 
     simulate(**flags)   -> SimulateResult      pwl simulate
     analyze(**flags)    -> AnalyzeResult       pwl analyze
@@ -45,13 +49,27 @@ def _text(values):
     return _np.array(values, dtype=str)
 
 
+def _counts(labels):
+    """'12 period-1, 3 chaotic': how many of each label, most frequent first."""
+    values, counts = _np.unique(_np.asarray(labels, dtype=str), return_counts=True)
+    order = _np.argsort(-counts, kind="stable")
+    return ", ".join("{} {}".format(counts[i], values[i]) for i in order)
+
+
 class _Result:
-    """A job's answer: its fields as attributes."""
+    """A job's answer: its fields as attributes; ``fields()`` lists them."""
 
     def __init__(self, fields):
         self.__dict__.update(fields)
 
+    def _summary(self):
+        return ""
+
     def __repr__(self):
+        return "{}({})".format(type(self).__name__, self._summary())
+
+    def fields(self):
+        """The result's fields, one per line, with the shape of each array."""
         def short(value):
             if isinstance(value, _np.ndarray):
                 return "array(shape={}, dtype={})".format(value.shape, value.dtype)
@@ -59,8 +77,7 @@ class _Result:
                 return "{" + ", ".join(sorted(value)) + "}"
             text = repr(value)
             return text if len(text) <= 60 else text[:57] + "..."
-        fields = ",\n  ".join("{}={}".format(k, short(v)) for k, v in self.__dict__.items())
-        return "{}(\n  {})".format(type(self).__name__, fields)
+        return "\n".join("{} = {}".format(k, short(v)) for k, v in self.__dict__.items())
 
 
 class SimulateResult(_Result):
@@ -79,6 +96,11 @@ class SimulateResult(_Result):
     dofs, forcing_period, section, description: the case
     """
 
+    def _summary(self):
+        return "{}: {} section points of {} components by {}, t from {:g} to {:g}".format(
+            self.description, len(self.t), self.poincare.shape[1], self.method,
+            self.t[0] if len(self.t) else 0.0, self.t[-1] if len(self.t) else 0.0)
+
 
 class AnalyzeResult(_Result):
     """One case classified, with its evidence (pwl analyze).
@@ -96,6 +118,10 @@ class AnalyzeResult(_Result):
     transient, recorded, mass, dofs, forcing_period, integrator, method, section, description
     """
 
+    def _summary(self):
+        return "{}, lambda1 = {:.4g} +- {:.2g}, K = {:.3g}; {} by {}".format(
+            self.regime, self.lambda1, self.lambda1_error, self.K, self.description, self.method)
+
 
 class SweepResult(_Result):
     """A one-parameter sweep (pwl sweep).
@@ -111,6 +137,11 @@ class SweepResult(_Result):
     section, description: the sweep's section and its settings (config.txt)
     points_of(index, direction="up"): the Poincaré points of one value
     """
+
+    def _summary(self):
+        return "{} from {:g} to {:g}, {} values ({}): {}".format(
+            self.parameter, self.values[0], self.values[-1], self.points, self.mode,
+            _counts(self.regime))
 
     def __init__(self, fields):
         for key in ("poincare_direction", "components"):
@@ -140,6 +171,10 @@ class MapResult(_Result):
     mode, description: the map's settings (config.txt)
     """
 
+    def _summary(self):
+        return "{} x {}, {} x {} cells: {}".format(
+            self.x, self.y, len(self.x_values), len(self.y_values), _counts(self.regime.ravel()))
+
     def __init__(self, fields):
         fields["table"] = {k: _text(v) if isinstance(v, list) else v
                            for k, v in fields["table"].items()}
@@ -165,6 +200,10 @@ class OrbitResult(_Result):
     method, method_default, description
     """
 
+    def _summary(self):
+        return "period-{} orbit, {}, largest |mu| {:.6g}, residual {:.2g}; {}".format(
+            self.period, self.verdict, self.largest_modulus, self.residual, self.description)
+
 
 class ContinuationResult(_Result):
     """A periodic orbit followed in one parameter (pwl continue).
@@ -179,6 +218,12 @@ class ContinuationResult(_Result):
     notes: why each branch stopped
     parameter_name, method, method_default, description
     """
+
+    def _summary(self):
+        kinds = _counts(self.bifurcations["type"]) if len(self.bifurcations["type"]) else "none"
+        return "{}: {} points on {} branch(es), {} stable; bifurcations: {}".format(
+            self.parameter_name, len(self.parameter), len(_np.unique(self.branch)),
+            int(_np.sum(self.stable)), kinds)
 
     def __init__(self, fields):
         fields["stable"] = fields["stable"].astype(bool)
@@ -227,3 +272,26 @@ def continue_(**flags):
 
 
 continuation = continue_
+
+
+def _document(function, job):
+    """Appends the job's keywords (the program's flags it takes) to `function`'s docstring, each
+    with its default and meaning, so that help(pwl.JOB) lists them."""
+    lines = ["", "Keyword arguments (the flags of ``pwl {}``; None leaves one out):".format(
+        job.rstrip("_")), ""]
+    lines.append("structure : Structure, default None")
+    lines.append("    An explicit structure in place of the chain's keywords (figure, n, alpha,")
+    lines.append("    zeta, gap, gaps, theta, loads); also accepted as structure_scene.")
+    for keyword, default, description, flag in _pwl.keywords(job):
+        kind = "bool" if flag else "value"
+        shown = default if default != "" else "none"
+        lines.append("{} : {}, default {}".format(keyword, kind, shown))
+        for line in description.splitlines():
+            lines.append("    " + line)
+    function.__doc__ = (function.__doc__ or "") + "\n" + "\n".join(lines) + "\n"
+
+
+for _function, _job in ((simulate, "simulate"), (analyze, "analyze"), (sweep, "sweep"),
+                        (map, "map"), (orbit, "orbit"), (continue_, "continue_")):
+    _document(_function, _job)
+del _function, _job

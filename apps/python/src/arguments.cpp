@@ -6,6 +6,7 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <string_view>
 #include <vector>
 
 #include "pwl/errors.hpp"
@@ -36,6 +37,13 @@ std::string item_text(const py::handle& value, const std::string& function,
   }
   throw py::type_error(fmt::format("{}(): {}={}: expected a number, a string or a list of them",
                                    function, keyword, py::repr(value).cast<std::string>()));
+}
+
+// A flag that takes FROM:TO (--range, --x-range, ...), by the name every such flag has.
+bool is_range_flag(const std::string& flag) {
+  constexpr std::string_view kRange = "range";
+  return flag.size() >= kRange.size() &&
+         flag.compare(flag.size() - kRange.size(), kRange.size(), kRange) == 0;
 }
 
 bool is_list(const py::handle& value) {
@@ -88,7 +96,17 @@ void parse_keywords(CLI::App& app, const std::string& function, const py::dict& 
       continue;
     }
     std::string text;
-    if (is_list(value)) {
+    if (is_range_flag(flag) && is_list(value)) {
+      // (FROM, TO): the command line's FROM:TO.
+      const py::list items = py::isinstance<py::array>(value)
+                                 ? py::list(value.attr("tolist")())
+                                 : py::list(py::reinterpret_borrow<py::object>(value));
+      if (items.size() != 2) {
+        throw py::type_error(fmt::format("{}(): {}={}: a range is two numbers, (FROM, TO)",
+                                         function, keyword, py::repr(value).cast<std::string>()));
+      }
+      text = item_text(items[0], function, keyword) + ":" + item_text(items[1], function, keyword);
+    } else if (is_list(value)) {
       const py::list items = py::isinstance<py::array>(value)
                                  ? py::list(value.attr("tolist")())
                                  : py::list(py::reinterpret_borrow<py::object>(value));
@@ -107,6 +125,41 @@ void parse_keywords(CLI::App& app, const std::string& function, const py::dict& 
   } catch (const CLI::ParseError& e) {
     throw InputError(e.what());
   }
+}
+
+std::vector<KeywordDoc> keyword_docs(const CLI::App& app) {
+  std::vector<KeywordDoc> docs;
+  for (const CLI::Option* option : app.get_options()) {
+    const std::string& name = option->get_single_name();
+    if (option->get_lnames().empty() || name == "help") continue;
+    KeywordDoc doc;
+    doc.keyword = name;
+    std::replace(doc.keyword.begin(), doc.keyword.end(), '-', '_');
+    doc.flag = option->get_expected_max() == 0;
+    doc.default_text = doc.flag ? "False" : option->get_default_str();
+    doc.description = option->get_description();
+    docs.push_back(std::move(doc));
+  }
+  return docs;
+}
+
+namespace {
+std::map<std::string, std::vector<KeywordDoc> (*)()>& keyword_registry() {
+  static std::map<std::string, std::vector<KeywordDoc> (*)()> registry;
+  return registry;
+}
+}  // namespace
+
+void register_keywords(const std::string& function, std::vector<KeywordDoc> (*describe)()) {
+  keyword_registry()[function] = describe;
+}
+
+std::vector<KeywordDoc> keywords_of(const std::string& function) {
+  const auto found = keyword_registry().find(function);
+  if (found == keyword_registry().end()) {
+    throw InputError(fmt::format("no job named {}", function));
+  }
+  return found->second();
 }
 
 }  // namespace pwl::python

@@ -8,7 +8,9 @@
 //   - None: the flag is not given (its default applies);
 //   - True / False: a flag (--locate-kinks) given or not;
 //   - int, str: as written; float: 17 significant digits, so the CLI reads the same double;
-//   - a list, tuple or 1-D NumPy array: its items joined by commas (--loads=1,-1,1,-1,1).
+//   - a list, tuple or 1-D NumPy array: its items joined by commas (--loads=1,-1,1,-1,1);
+//   - a range (a flag named *range, FROM:TO on the command line): a pair of numbers, (0.5, 3) for
+//     --range=0.5:3, or the string as written.
 // A keyword that names no flag of the job raises TypeError naming it; a value the CLI refuses
 // raises pwl.InputError with the CLI's message ("--n: must be a positive number, got 0").
 #include <pybind11/pybind11.h>
@@ -16,6 +18,7 @@
 #include <CLI/CLI.hpp>
 #include <map>
 #include <string>
+#include <vector>
 
 namespace pwl::python {
 
@@ -35,5 +38,23 @@ void parse_keywords(CLI::App& app, const std::string& function, const pybind11::
 
 // "--skip-periods" for "skip_periods".
 std::string flag_of(const std::string& keyword);
+
+// One keyword of a job, for its docstring: the keyword, what --help shows as its default ("" for
+// none), its description, and whether it is a flag (True/False).
+struct KeywordDoc {
+  std::string keyword;
+  std::string default_text;
+  std::string description;
+  bool flag = false;
+};
+
+// Every option of `app` (after leave_out) as keywords, in --help's order.
+std::vector<KeywordDoc> keyword_docs(const CLI::App& app);
+
+// The keyword docs of the job named `function` ("simulate", ...), registered by the job's
+// binding (bind_run_jobs, bind_orbit_jobs) with `describe`, which builds the job's app as its
+// function does; keywords_of throws InputError for a name none registered.
+void register_keywords(const std::string& function, std::vector<KeywordDoc> (*describe)());
+std::vector<KeywordDoc> keywords_of(const std::string& function);
 
 }  // namespace pwl::python

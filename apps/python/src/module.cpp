@@ -1,7 +1,8 @@
 // The extension pwl._pwl: pwl's jobs for Python. The package pwl (pwl/__init__.py) wraps its
-// functions' dicts into result objects; see there and README.md, "From Python".
+// functions' dicts into result objects; see there and apps/python/README.md.
 #include <pybind11/pybind11.h>
 
+#include "arguments.hpp"
 #include "jobs.hpp"
 #include "pwl/errors.hpp"
 #include "structure.hpp"
@@ -15,4 +16,13 @@ PYBIND11_MODULE(_pwl, m) {
   pwl::python::bind_structure(m);
   pwl::python::bind_orbit_jobs(m);
   pwl::python::bind_run_jobs(m);
+  // The keywords of a job, for the docstrings pwl/__init__.py writes: (keyword, default as --help
+  // shows it, description, is a flag) in --help's order.
+  m.def("keywords", [](const std::string& job) {
+    pybind11::list rows;
+    for (const auto& k : pwl::python::keywords_of(job)) {
+      rows.append(pybind11::make_tuple(k.keyword, k.default_text, k.description, k.flag));
+    }
+    return rows;
+  });
 }

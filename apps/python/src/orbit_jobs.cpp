@@ -33,6 +33,32 @@ const LeftOut kContinueLeftOut{
     {"--threads", "it sets the threads of --over-sweep, which pwl.continue_ does not run"},
 };
 
+// The flags pwl.orbit takes: pwl orbit's, less those it leaves out.
+void orbit_app(CLI::App& app, app::OrbitCommandFlags& flags) {
+  app::add_orbit_command_flags(app, flags);
+  leave_out(app, kOrbitLeftOut);
+}
+std::vector<KeywordDoc> orbit_keywords() {
+  CLI::App app{"pwl.orbit"};
+  app.option_defaults()->always_capture_default();
+  app::OrbitCommandFlags flags;
+  orbit_app(app, flags);
+  return keyword_docs(app);
+}
+
+// The flags pwl.continue_ takes: pwl continue's, less those it leaves out.
+void continuation_app(CLI::App& app, app::ContinueFlags& flags) {
+  app::add_continue_flags(app, flags);
+  leave_out(app, kContinueLeftOut);
+}
+std::vector<KeywordDoc> continuation_keywords() {
+  CLI::App app{"pwl.continue_"};
+  app.option_defaults()->always_capture_default();
+  app::ContinueFlags flags;
+  continuation_app(app, flags);
+  return keyword_docs(app);
+}
+
 py::dict multipliers_dict(const orbits::FloquetMultipliers& mu) {
   py::dict d;
   d["multipliers"] = complex_array(mu.values);
@@ -48,8 +74,7 @@ py::dict orbit(py::kwargs kwargs) {
   const auto file = take_structure(args);
   CLI::App app{"pwl.orbit"};
   app::OrbitCommandFlags flags;
-  app::add_orbit_command_flags(app, flags);
-  leave_out(app, kOrbitLeftOut);
+  orbit_app(app, flags);
   parse_keywords(app, "orbit", args, kOrbitLeftOut);
   app::read_method_given(app, flags.orbit);
 
@@ -102,8 +127,7 @@ py::dict continuation(py::kwargs kwargs) {
   const auto file = take_structure(args);
   CLI::App app{"pwl.continue_"};
   app::ContinueFlags flags;
-  app::add_continue_flags(app, flags);
-  leave_out(app, kContinueLeftOut);
+  continuation_app(app, flags);
   parse_keywords(app, "continue_", args, kContinueLeftOut);
   app::read_method_given(app, flags.orbit);
 
@@ -220,6 +244,8 @@ py::dict continuation(py::kwargs kwargs) {
 void bind_orbit_jobs(py::module_& m) {
   m.def("orbit", &orbit, "The period-k orbit by shooting: see pwl.orbit.");
   m.def("continue_", &continuation, "Continuation of a periodic orbit: see pwl.continue_.");
+  register_keywords("orbit", &orbit_keywords);
+  register_keywords("continue_", &continuation_keywords);
 }
 
 }  // namespace pwl::python

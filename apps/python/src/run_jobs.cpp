@@ -50,6 +50,58 @@ const LeftOut kMapLeftOut{
     {"--no-plot", "pwl.map draws nothing"},
 };
 
+// The flags pwl.simulate takes: pwl simulate's, less those it leaves out.
+void simulate_app(CLI::App& app, app::SimulateOptions& options) {
+  app::add_simulate_flags(app, options);
+  leave_out(app, kSimulateLeftOut);
+}
+std::vector<KeywordDoc> simulate_keywords() {
+  CLI::App app{"pwl.simulate"};
+  app.option_defaults()->always_capture_default();
+  app::SimulateOptions options;
+  simulate_app(app, options);
+  return keyword_docs(app);
+}
+
+// The flags pwl.analyze takes: pwl analyze's, less those it leaves out.
+void analyze_app(CLI::App& app, app::AnalyzeOptions& options) {
+  app::add_analyze_flags(app, options);
+  leave_out(app, kAnalyzeLeftOut);
+}
+std::vector<KeywordDoc> analyze_keywords() {
+  CLI::App app{"pwl.analyze"};
+  app.option_defaults()->always_capture_default();
+  app::AnalyzeOptions options;
+  analyze_app(app, options);
+  return keyword_docs(app);
+}
+
+// The flags pwl.sweep takes: pwl sweep's, less those it leaves out.
+void sweep_app(CLI::App& app, app::SweepFlags& flags) {
+  app::add_sweep_flags(app, flags);
+  leave_out(app, kSweepLeftOut);
+}
+std::vector<KeywordDoc> sweep_keywords() {
+  CLI::App app{"pwl.sweep"};
+  app.option_defaults()->always_capture_default();
+  app::SweepFlags flags;
+  sweep_app(app, flags);
+  return keyword_docs(app);
+}
+
+// The flags pwl.map takes: pwl map's, less those it leaves out.
+void map_app(CLI::App& app, app::MapFlags& flags) {
+  app::add_map_flags(app, flags);
+  leave_out(app, kMapLeftOut);
+}
+std::vector<KeywordDoc> map_keywords() {
+  CLI::App app{"pwl.map"};
+  app.option_defaults()->always_capture_default();
+  app::MapFlags flags;
+  map_app(app, flags);
+  return keyword_docs(app);
+}
+
 std::vector<std::string> state_names(Index n) {
   std::vector<std::string> names;
   for (const char kind : {'x', 'v'}) {
@@ -85,8 +137,7 @@ py::dict simulate(py::kwargs kwargs) {
   const auto file = take_structure(args);
   CLI::App app{"pwl.simulate"};
   app::SimulateOptions options;
-  app::add_simulate_flags(app, options);
-  leave_out(app, kSimulateLeftOut);
+  simulate_app(app, options);
   parse_keywords(app, "simulate", args, kSimulateLeftOut);
 
   SimulationCollector arrays;
@@ -168,8 +219,7 @@ py::dict analyze(py::kwargs kwargs) {
   const auto file = take_structure(args);
   CLI::App app{"pwl.analyze"};
   app::AnalyzeOptions options;
-  app::add_analyze_flags(app, options);
-  leave_out(app, kAnalyzeLeftOut);
+  analyze_app(app, options);
   parse_keywords(app, "analyze", args, kAnalyzeLeftOut);
 
   app::AnalyzeResult a;
@@ -263,8 +313,7 @@ py::dict sweep(py::kwargs kwargs) {
   const auto file = take_structure(args);
   CLI::App app{"pwl.sweep"};
   app::SweepFlags flags;
-  app::add_sweep_flags(app, flags);
-  leave_out(app, kSweepLeftOut);
+  sweep_app(app, flags);
   parse_keywords(app, "sweep", args, kSweepLeftOut);
 
   const analysis::SweepOptions o = app::sweep_options(flags);
@@ -341,8 +390,7 @@ py::dict map(py::kwargs kwargs) {
   const auto file = take_structure(args);
   CLI::App app{"pwl.map"};
   app::MapFlags flags;
-  app::add_map_flags(app, flags);
-  leave_out(app, kMapLeftOut);
+  map_app(app, flags);
   parse_keywords(app, "map", args, kMapLeftOut);
 
   const analysis::RegimeMapOptions o = app::map_options(flags);
@@ -386,6 +434,10 @@ void bind_run_jobs(py::module_& m) {
   m.def("analyze", &analyze, "One case classified: see pwl.analyze.");
   m.def("sweep", &sweep, "A one-parameter sweep: see pwl.sweep.");
   m.def("map", &map, "A two-parameter regime map: see pwl.map.");
+  register_keywords("simulate", &simulate_keywords);
+  register_keywords("analyze", &analyze_keywords);
+  register_keywords("sweep", &sweep_keywords);
+  register_keywords("map", &map_keywords);
 }
 
 }  // namespace pwl::python

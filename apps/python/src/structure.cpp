@@ -187,6 +187,15 @@ line). Any job takes it as structure=S, in place of the chain's keywords.)doc")
 }
 
 std::unique_ptr<app::StructureSceneFile> take_structure(py::dict& kwargs) {
+  // A pwl.Structure given where a scene file goes is the structure itself.
+  if (kwargs.contains("structure_scene") &&
+      py::isinstance<GapStructure>(kwargs["structure_scene"])) {
+    if (kwargs.contains("structure") && !kwargs["structure"].is_none()) {
+      throw InputError("structure: give an explicit structure or structure_scene, not both");
+    }
+    kwargs["structure"] = kwargs["structure_scene"];
+    PyDict_DelItemString(kwargs.ptr(), "structure_scene");
+  }
   if (!kwargs.contains("structure")) return nullptr;
   const py::object value = kwargs["structure"];
   PyDict_DelItemString(kwargs.ptr(), "structure");

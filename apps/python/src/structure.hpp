@@ -13,7 +13,7 @@ namespace pwl::python {
 
 void bind_structure(pybind11::module_& m);
 
-// Takes the keyword `structure` out of `kwargs`. When it is a pwl.Structure, checks that no chain
+// Takes the keyword `structure` out of `kwargs` (or `structure_scene` when it is a pwl.Structure). When it is a pwl.Structure, checks that no chain
 // keyword (figure, n, alpha, zeta, gap, gaps, theta, loads) nor structure_scene is given with it,
 // writes it as a scene file and sets structure_scene to that file, which lives as long as the
 // returned object (null without a structure). Throws TypeError for another type, InputError for a
