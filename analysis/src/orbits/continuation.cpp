@@ -103,6 +103,7 @@ struct Signature {
   int real_below_minus_one = 0;
   int complex_outside = 0;    // complex μ with |μ| > 1
   int outside = 0;            // all with |μ| > 1
+  bool operator==(const Signature&) const = default;
 };
 
 Signature signature(const FloquetMultipliers& mu) {
@@ -193,6 +194,11 @@ constexpr Index kChordAbove = 20;
 // orbits closed to 1e-10 were off by up to 8.9e-8, and on orbits closed to 1e-12 they agreed
 // between the two correctors to 1e-9.
 constexpr double kLocateResidual = 1e-12;
+// A real multiplier within this of +1 or -1 at both ends of a step is pinned there, not crossing.
+constexpr double kPinned = 1e-6;
+// A step whose multipliers' signature is not explained is cut in two at most this many times in
+// a row (2^-30 of the step).
+constexpr int kMaxCuts = 30;
 
 class Continuer {
  public:
@@ -515,46 +521,176 @@ class Continuer {
   }
 
   // The bifurcations between two consecutive points a and b (b predicted from a with step h
-  // along a's tangent), located and recorded.
+  // along a's tangent), located and recorded: those the multipliers' signature shows
+  // (explain_signature), then the grazings the orbits' profiles show.
+  // They are recorded in their order along the branch.
   void detect(Point& a, Point& b, double h, int branch, int period) {
-    const Signature sa = signature(a.mu), sb = signature(b.mu);
-    std::vector<std::pair<BifurcationType, int>> found;  // type, spring (grazing) * 2 + which
-    // A real multiplier that stays within kNoise of ±1 at both points is not a transversal
-    // crossing but a multiplier pinned there (the +1 of a period-2k branch at the period doubling
-    // it starts from), wobbling by rounding.
-    constexpr double kNoise = 1e-6;
-    const auto clear = [&](double target) {
-      return std::max(std::abs(nearest_real(a.mu, target) - target),
-                      std::abs(nearest_real(b.mu, target) - target)) > kNoise;
-    };
-    // A switched branch starts at a period doubling, where its own multiplier +1 is pinned: no
-    // fold is taken within 1e-4 of the range from its start.
-    const bool at_switch = branch > 0 &&
-                           std::max(std::abs(a.p - branch_start_), std::abs(b.p - branch_start_)) <=
-                               1e-4 * (hi_ - lo_);
-    if ((sa.real_above_one - sb.real_above_one) % 2 != 0 && clear(1.0) && !at_switch) {
-      found.emplace_back(BifurcationType::fold, -1);
-    }
-    if ((sa.real_below_minus_one - sb.real_below_minus_one) % 2 != 0 && clear(-1.0)) {
-      found.emplace_back(BifurcationType::period_doubling, -1);
-    }
-    if (sa.complex_outside != sb.complex_outside &&
-        sa.outside - sb.outside == sa.complex_outside - sb.complex_outside) {
-      found.emplace_back(BifurcationType::neimark_sacker, -1);
-    }
+    step_found_.clear();
+    explain_signature(a, b, h, branch, period, 0);
     if (options_.grazing) {
       const OrbitProfile& pa = profile_of(a, period);
       const OrbitProfile& pb = profile_of(b, period);
       for (Index j = 0; j < pa.max_gap.size(); ++j) {
-        if ((pa.max_gap(j) > 0) != (pb.max_gap(j) > 0)) {
-          found.emplace_back(BifurcationType::grazing, static_cast<int>(2 * j));
-        }
-        if ((pa.min_gap(j) > 0) != (pb.min_gap(j) > 0)) {
-          found.emplace_back(BifurcationType::grazing, static_cast<int>(2 * j + 1));
+        for (const int which : {static_cast<int>(2 * j), static_cast<int>(2 * j + 1)}) {
+          const bool largest = which % 2 == 0;
+          if (((largest ? pa.max_gap(j) : pa.min_gap(j)) > 0) ==
+              ((largest ? pb.max_gap(j) : pb.min_gap(j)) > 0)) {
+            continue;
+          }
+          step_found_.push_back({BifurcationType::grazing, which,
+                                 locate(a, b, h, BifurcationType::grazing, which, period), a.p,
+                                 b.p});
         }
       }
     }
-    for (const auto& [type, which] : found) locate(a, b, h, type, which, branch, period);
+    const Index N = a.y.size();
+    const auto along = [&](const Found& f) {
+      return a.tangent.head(N).dot(f.where.best.y - a.y) + a.tangent(N) * (f.where.best.p - a.p);
+    };
+    std::stable_sort(step_found_.begin(), step_found_.end(),
+                     [&](const Found& x, const Found& y) { return along(x) < along(y); });
+    for (const Found& f : step_found_) {
+      if (retracing_) return;
+      record(f.type, f.which, branch, period, f.where, f.from, f.to);
+    }
+  }
+
+  // What changes in the multipliers' signature from a to b (multipliers outside the unit circle
+  // by kind: real above +1, real below -1, complex pairs), as one event, none, or several.
+  enum class Change { none, fold, period_doubling, neimark_sacker, several };
+  Change change_between(const Point& a, const Point& b, int branch) const {
+    const Signature sa = signature(a.mu), sb = signature(b.mu);
+    const int plus = sb.real_above_one - sa.real_above_one;
+    const int minus = sb.real_below_minus_one - sa.real_below_minus_one;
+    const int pairs = (sb.complex_outside - sa.complex_outside) / 2;
+    if (plus == 0 && minus == 0 && pairs == 0) return Change::none;
+    // A complex pair outside the circle meeting the real axis there (two real multipliers beyond
+    // +1 or below -1), or two such real multipliers splitting into a pair: no bifurcation.
+    if (std::abs(pairs) == 1 && ((plus == -2 * pairs && minus == 0) ||
+                                 (minus == -2 * pairs && plus == 0))) {
+      return Change::none;
+    }
+    // A real multiplier that stays within kPinned of +1 or -1 at both points is not a
+    // transversal crossing but a multiplier pinned there (the +1 of a period-2k branch at the
+    // period doubling it starts from, or of a structure that is free to drift), wobbling by
+    // rounding.
+    const auto pinned = [&](double target) {
+      const double at_a = nearest_real(a.mu, target), at_b = nearest_real(b.mu, target);
+      return std::isfinite(at_a) && std::isfinite(at_b) &&
+             std::max(std::abs(at_a - target), std::abs(at_b - target)) <= kPinned;
+    };
+    if (std::abs(plus) == 1 && minus == 0 && pairs == 0) {
+      // A switched branch starts at a period doubling, where its own multiplier +1 is pinned: no
+      // fold is taken within 1e-4 of the range from its start.
+      const bool at_switch =
+          branch > 0 && std::max(std::abs(a.p - branch_start_), std::abs(b.p - branch_start_)) <=
+                            1e-4 * (hi_ - lo_);
+      return pinned(1.0) || at_switch ? Change::none : Change::fold;
+    }
+    if (std::abs(minus) == 1 && plus == 0 && pairs == 0) {
+      return pinned(-1.0) ? Change::none : Change::period_doubling;
+    }
+    if (std::abs(pairs) == 1 && plus == 0 && minus == 0) return Change::neimark_sacker;
+    return Change::several;
+  }
+
+  static BifurcationType type_of(Change change) {
+    switch (change) {
+      case Change::fold: return BifurcationType::fold;
+      case Change::period_doubling: return BifurcationType::period_doubling;
+      default: return BifurcationType::neimark_sacker;
+    }
+  }
+
+  // Every change of the multipliers' signature from a to b (b at arclength s along a's tangent)
+  // explained by bifurcations located between them: one event (a fold changes the count beyond
+  // +1 by one, a period doubling the count beyond -1, a Neimark–Sacker point the complex pairs
+  // outside) is located, and kept when the ends of its final bracket show the whole change and
+  // nothing else happens between them and a or b. Anything else (several events in the step, an
+  // event whose location lands elsewhere, a test function that jumps where multipliers collide on
+  // the real axis) cuts the step in two at half its arclength, the half point corrected onto the
+  // branch with its own multipliers, and each half is explained in turn, until each event sits
+  // alone in its interval. A grazing explains no change of signature: the map is C¹ there and
+  // the multipliers pass through it continuously, however steeply (SPEC §8).
+  void explain_signature(Point& a, Point& b, double s, int branch, int period, int depth) {
+    const Change change = change_between(a, b, branch);
+    if (change == Change::none) return;
+    if (change != Change::several) {
+      const BifurcationType type = type_of(change);
+      const Located found = locate(a, b, s, type, -1, period);
+      // The bracket's ends have a's and b's signatures: the one event accounts for the whole
+      // change (compared as counts: the ends lie within the location's tolerance of the event,
+      // where the crossing multiplier is within kPinned of ±1).
+      if (found.located && signature(found.before->mu) == signature(a.mu) &&
+          signature(found.after->mu) == signature(b.mu)) {
+        step_found_.push_back({type, -1, found, a.p, b.p});
+        return;
+      }
+      if (!found.located && !can_cut(s, depth)) {
+        step_found_.push_back({type, -1, found, a.p, b.p});
+        return;
+      }
+    }
+    std::optional<Point> half;
+    if (can_cut(s, depth)) half = point_between(a, b, s, period);
+    if (!half) {
+      note(fmt::format("between {} = {:.10g} and {:.10g} on branch {} the multipliers' signature "
+                       "changes by more than one event that could not be told apart (the step "
+                       "cannot be cut further); each kind of change located on the whole step",
+                       options_.parameter.name(), a.p, b.p, branch));
+      located_by_parity(a, b, s, period);
+      return;
+    }
+    ++result_.step_cuts;
+    const Index N = a.y.size();
+    Vector to_b(N + 1);
+    to_b.head(N) = b.y - half->y;
+    to_b(N) = b.p - half->p;
+    explain_signature(a, *half, 0.5 * s, branch, period, depth + 1);
+    explain_signature(*half, b, half->tangent.dot(to_b), branch, period, depth + 1);
+  }
+
+  // Whether an interval of arclength s at this depth of cutting may be cut again.
+  bool can_cut(double s, int depth) const {
+    return depth < kMaxCuts && std::abs(s) > 2 * std::min(min_step_, 1e-9 * (hi_ - lo_));
+  }
+
+  // The branch's point at half the arclength s from a toward b, corrected onto the branch along
+  // a's tangent, with its multipliers, ∂F/∂p and tangent; empty where the corrector fails.
+  std::optional<Point> point_between(Point& a, Point& b, double s, int period) {
+    const Index N = a.y.size();
+    const double half = 0.5 * s;
+    const Vector y_guess = 0.5 * (a.y + b.y);
+    const double p_guess = 0.5 * (a.p + b.p);
+    const Vector y_pred = a.y + half * a.tangent.head(N);
+    const double p_pred = a.p + half * a.tangent(N);
+    Matrix jacobian;
+    if (chord_) jacobian = 0.5 * (a.M + b.M);
+    std::optional<Point> pt =
+        correct_from(y_guess, p_guess, y_pred, p_pred, a.tangent, a.b, period,
+                     chord_ ? &jacobian : nullptr, options_.max_corrections + 3);
+    if (!pt) return std::nullopt;
+    pt->b = parameter_derivative(pt->y, pt->p, period);
+    pt->tangent = tangent_at(*pt, a.tangent);
+    return pt;
+  }
+
+  // The old rule, where the step cannot be cut further: each kind whose count changes by an odd
+  // number (folds, period doublings) or whose complex pairs outside change, located on the whole
+  // step, with a note.
+  void located_by_parity(Point& a, Point& b, double s, int period) {
+    const Signature sa = signature(a.mu), sb = signature(b.mu);
+    std::vector<BifurcationType> types;
+    if ((sa.real_above_one - sb.real_above_one) % 2 != 0) types.push_back(BifurcationType::fold);
+    if ((sa.real_below_minus_one - sb.real_below_minus_one) % 2 != 0) {
+      types.push_back(BifurcationType::period_doubling);
+    }
+    if (((sa.complex_outside - sb.complex_outside) / 2) % 2 != 0) {
+      types.push_back(BifurcationType::neimark_sacker);
+    }
+    for (const BifurcationType type : types) {
+      step_found_.push_back({type, -1, locate(a, b, s, type, -1, period), a.p, b.p});
+    }
   }
 
   // `variant` picks among the test functions of one kind: the first one whose signs differ at the
@@ -582,7 +718,9 @@ class Continuer {
       case BifurcationType::fold: return product_shifted(pt.mu, 1.0);
       case BifurcationType::period_doubling: return product_shifted(pt.mu, -1.0);
       // The modulus of the complex pair nearest the circle, less 1 (the second variant: Π over
-      // the complex pairs of (|μ|² − 1), which changes sign where one pair crosses).
+      // the complex pairs of (|μ|² − 1), which changes sign where one pair crosses). Both jump
+      // where multipliers collide on the real axis; explain_signature checks the bracket a
+      // location ends on and cuts the step where it landed on such a jump.
       case BifurcationType::neimark_sacker: return std::abs(nearest_complex_to_circle(pt.mu)) - 1.0;
       case BifurcationType::grazing: {
         const OrbitProfile& prof = profile_of(pt, period);
@@ -592,8 +730,20 @@ class Continuer {
     return std::numeric_limits<double>::quiet_NaN();
   }
 
-  void locate(Point& a, Point& b, double h, BifurcationType type, int which, int branch,
-              int period) {
+  // A test function's zero between two points of the branch: the trial point nearest it, its
+  // value, and the two points of the final bracket in the order of the arclength (the one toward
+  // a first), each with its multipliers.
+  struct Located {
+    Point best;
+    double test_value = 0.0;
+    bool located = false;
+    std::optional<Point> before, after;
+  };
+
+  // Locates the zero of the test function of `type` (`which`: the spring and extreme of a
+  // grazing) between a and b, b at arclength h along a's tangent: the Illinois variant of regula
+  // falsi on the arclength, every trial point corrected onto the branch.
+  Located locate(Point& a, Point& b, double h, BifurcationType type, int which, int period) {
     const Index N = a.y.size();
     double sa = 0, sb = h;
     int variant = 0;
@@ -606,21 +756,24 @@ class Continuer {
       fa = test_function(a, type, which, period, v);
       fb = test_function(b, type, which, period, v);
     }
-    Point best = fabs_less(fa, fb) ? a : b;
-    double fbest = fabs_less(fa, fb) ? fa : fb;
-    double pa = a.p, pb = b.p;
-    Vector ya = a.y, yb = b.y;
-    bool located = std::isfinite(fa) && std::isfinite(fb) && fa * fb <= 0;
+    Located out;
+    out.best = fabs_less(fa, fb) ? a : b;
+    out.test_value = fabs_less(fa, fb) ? fa : fb;
+    Point end_a = a, end_b = b;  // the bracket's ends, at sa and sb
+    out.located = std::isfinite(fa) && std::isfinite(fb) && fa * fb <= 0;
     int side = 0;  // Illinois: which end was kept last
-    for (int it = 0; located && it < 80; ++it) {
-      if (std::abs(pb - pa) <= options_.locate_tolerance && std::abs(sb - sa) <= 1e-6 * h) break;
-      if (std::abs(sb - sa) <= 1e-13 * h) break;
+    for (int it = 0; out.located && it < 80; ++it) {
+      if (std::abs(end_b.p - end_a.p) <= options_.locate_tolerance &&
+          std::abs(sb - sa) <= 1e-6 * std::abs(h)) {
+        break;
+      }
+      if (std::abs(sb - sa) <= 1e-13 * std::abs(h)) break;
       double s = sb - fb * (sb - sa) / (fb - fa);
       if (!(s > std::min(sa, sb) && s < std::max(sa, sb))) s = 0.5 * (sa + sb);
       // Predict by interpolating the bracket's ends, constrain to a's tangent at arclength s.
       const double w = (s - sa) / (sb - sa);
-      const Vector y_guess = (1 - w) * ya + w * yb;
-      const double p_guess = (1 - w) * pa + w * pb;
+      const Vector y_guess = (1 - w) * end_a.y + w * end_b.y;
+      const double p_guess = (1 - w) * end_a.p + w * end_b.p;
       const Vector y_pred = a.y + s * a.tangent.head(N);
       const double p_pred = a.p + s * a.tangent(N);
       // The chord corrector starts from the monodromy interpolated like the guess.
@@ -634,35 +787,49 @@ class Continuer {
                        chord_ ? &jacobian : nullptr, options_.max_corrections + 3,
                        type != BifurcationType::grazing, kLocateResidual);
       if (!pt) {
-        located = false;
+        out.located = false;
         break;
       }
       const double f = test_function(*pt, type, which, period, variant);
       if (!std::isfinite(f)) {
-        located = false;
+        out.located = false;
         break;
       }
-      if (std::abs(f) < std::abs(fbest)) {
-        best = *pt;
-        fbest = f;
+      if (std::abs(f) < std::abs(out.test_value)) {
+        out.best = *pt;
+        out.test_value = f;
       }
       if (f * fb < 0) {
-        sa = sb, fa = fb, pa = pb, ya = yb;
+        sa = sb, fa = fb;
+        end_a = std::move(end_b);
         side = 0;
       } else {
         if (side == 1) fa /= 2;  // Illinois
         side = 1;
       }
-      sb = s, fb = f, pb = pt->p, yb = pt->y;
+      sb = s, fb = f;
+      end_b = std::move(*pt);
       if (f == 0) break;
     }
+    if (sa <= sb) {
+      out.before = std::move(end_a), out.after = std::move(end_b);
+    } else {
+      out.before = std::move(end_b), out.after = std::move(end_a);
+    }
+    return out;
+  }
+
+  // Records a bifurcation located (or only detected) between the points at `from` and `to`.
+  void record(BifurcationType type, int which, int branch, int period, const Located& found,
+              double from, double to) {
+    const Point& best = found.best;
     Bifurcation bif;
     bif.type = type;
     bif.branch = branch;
     bif.period = period;
     bif.parameter = best.p;
     bif.state = best.y;
-    bif.test_value = fbest;
+    bif.test_value = found.test_value;
     if (type == BifurcationType::fold) bif.multiplier = nearest_real(best.mu, 1.0);
     if (type == BifurcationType::period_doubling) bif.multiplier = nearest_real(best.mu, -1.0);
     if (type == BifurcationType::neimark_sacker) bif.multiplier = nearest_complex_to_circle(best.mu);
@@ -670,7 +837,7 @@ class Continuer {
       bif.spring = which / 2;
       bif.at_largest_gap = which % 2 == 0;
     }
-    bif.located = located;
+    bif.located = found.located;
     // A switched branch that meets a bifurcation of its own again retraces its orbits, each now
     // started some periods later (a period-2k loop traversed as its two halves): stop it there.
     if (branch > 0) {
@@ -682,15 +849,15 @@ class Continuer {
         }
       }
     }
-    if (!located) {
+    if (!found.located) {
       note(fmt::format("{} near {} = {:.10g} on branch {}: detected, not located (bracket {:.10g} "
                        "to {:.10g})",
-                       bifurcation_name(type), options_.parameter.name(), best.p, branch, a.p,
-                       b.p));
+                       bifurcation_name(type), options_.parameter.name(), best.p, branch, from,
+                       to));
     }
     result_.bifurcations.push_back(bif);
     if (observer_ != nullptr) observer_->bifurcation(bif);
-    if (type == BifurcationType::period_doubling && options_.switch_branches && located) {
+    if (type == BifurcationType::period_doubling && options_.switch_branches && found.located) {
       pending_.push_back({best, period, result_.bifurcations.size() - 1});
     }
   }
@@ -937,6 +1104,15 @@ class Continuer {
   std::deque<Pending> pending_;
   int branches_ = 0;
   bool retracing_ = false;
+  // The bifurcations found in the step being explained, before they are recorded in their order
+  // along the branch.
+  struct Found {
+    BifurcationType type;
+    int which;  // grazing: spring * 2 + (0: largest gap, 1: smallest)
+    Located where;
+    double from, to;  // the parameter at the ends of the interval it was found in
+  };
+  std::vector<Found> step_found_;
   double branch_start_ = 0.0;  // parameter of the first point of the branch being followed
   double initial_step_ = 0, min_step_ = 0, max_step_ = 0, lo_ = 0, hi_ = 0;
 };

@@ -455,6 +455,9 @@ void continue_orbit(const ContinueFlags& f) {
     fmt::print("notes:\n");
     for (const std::string& note : result.notes) fmt::print("  {}\n", note);
   }
+  fmt::print("work: {} monodromies, {} other integrations of the map; {} step(s) cut to explain "
+             "the multipliers' signature\n",
+             result.monodromies, result.integrations, result.step_cuts);
   fmt::print("time: {:.2f} s ({} points)\n", seconds, outputs.points());
   fmt::print("wrote {0}/branch.csv, {0}/branch_section.csv and {0}/bifurcations.csv\n", o.out);
   if (!f.no_plot) {

@@ -20,16 +20,26 @@
 // within 2e-4 of the prediction, relative to the state) and shrinks after hard ones or a turn of
 // the tangent by more than 30°.
 //
-// Bifurcations, between two accepted points, from the Floquet multipliers and the orbit's profile:
-//  - fold: a real multiplier crosses +1 (the parity of the real multipliers beyond +1 changes);
-//  - period doubling: a real multiplier crosses −1;
-//  - Neimark–Sacker: a complex pair crosses the unit circle (the count of complex multipliers
-//    outside it changes, and the count of all multipliers outside it by as much);
+// Bifurcations, between two accepted points, from the Floquet multipliers and the orbit's profile.
+// The multipliers outside the unit circle are counted by kind at both ends of every step (real
+// beyond +1, real below −1, complex pairs), each end on its own orbit, and every change of those
+// counts must be explained by the events located inside the step:
+//  - fold: a real multiplier crosses +1 (the count beyond +1 changes by one);
+//  - period doubling: a real multiplier crosses −1 (the count below −1 changes by one);
+//  - Neimark–Sacker: a complex pair crosses the unit circle (the complex pairs outside change by
+//    one);
+//  - a complex pair that meets the real axis inside the circle changes nothing, and one that meets
+//    it outside turns into two real multipliers beyond ±1: no bifurcation.
+// A change that is none of these alone (several events in one step, say a complex pair turning
+// real past a grazing and one of the two then crossing −1), or an event whose location does not
+// account for the whole change, cuts the step in two at half its arclength, and each half is
+// explained in turn, until each event sits alone in its interval and is located. Beside those:
 //  - grazing: the largest (or smallest) value along the orbit of a gap function g_j passes through
 //    zero, so a contact appears or disappears. In a structure with continuous piecewise-linear
 //    forces the map stays C¹ there, but its multipliers may change at an unbounded rate
 //    (M. di Bernardo, C. J. Budd, A. R. Champneys and P. Kowalczyk, Piecewise-smooth Dynamical
-//    Systems, Springer 2008, ch. 6 and 8).
+//    Systems, Springer 2008, ch. 6 and 8). A grazing explains no change of the multipliers' counts:
+//    they move continuously through it.
 // Each is located by the Illinois variant of regula falsi on the arclength between the two points
 // (every trial point corrected onto the branch) on a test function that vanishes there: the real
 // multiplier nearest ±1 minus ±1, the modulus of the complex pair nearest the circle minus 1, the
@@ -145,6 +155,9 @@ struct ContinuationResult {
   long monodromies = 0;
   long integrations = 0;
   long chord_stalls = 0;  // chord steps that stalled, after which the monodromy was formed again
+  // Steps cut in two because the multipliers' signature changed in a way the events located in
+  // them did not explain (several events in one step).
+  long step_cuts = 0;
   Corrector corrector = Corrector::newton;  // the one used (chord or newton)
 };
 
