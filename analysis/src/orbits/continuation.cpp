@@ -22,23 +22,6 @@ std::string bifurcation_name(BifurcationType type) {
   return "?";
 }
 
-std::string corrector_name(Corrector corrector) {
-  switch (corrector) {
-    case Corrector::automatic: return "automatic";
-    case Corrector::chord: return "chord";
-    case Corrector::newton: return "newton";
-  }
-  return "?";
-}
-
-Corrector parse_corrector(const std::string& name) {
-  for (Corrector c : {Corrector::automatic, Corrector::chord, Corrector::newton}) {
-    if (corrector_name(c) == name) return c;
-  }
-  throw InputError(
-      fmt::format("corrector = \"{}\" is not known; use automatic, chord or newton", name));
-}
-
 bool ContinuationOptions::is_valid(std::string* why) const {
   std::string scratch;
   if (why == nullptr) why = &scratch;
@@ -149,40 +132,28 @@ double product_shifted(const FloquetMultipliers& mu, double target) {
   return product.real();
 }
 
-// The bordered Jacobian of pseudo-arclength continuation, [M − I, b; row^T]: regular at a fold.
-Matrix bordered(const Matrix& M, const Vector& b, const Vector& row) {
-  const Index N = M.rows();
-  Matrix A(N + 1, N + 1);
-  A.topLeftCorner(N, N) = M - Matrix::Identity(N, N);
-  A.topRightCorner(N, 1) = b;
-  A.bottomRows(1) = row.transpose();
-  return A;
-}
-
-// A point being built: (y, p) and what was computed there.
-struct Point {
-  Vector y;   // state
-  double p = 0.0;
-  Matrix M;   // monodromy
+// A point of the branch: u = (y, p), and what was computed there.
+struct Point : CurvePoint {
+  Matrix M;  // monodromy (empty where the corrector did not form it at the point)
   FloquetMultipliers mu;
-  Vector b;   // ∂F/∂p
-  Vector tangent;  // unit tangent (y, p), oriented along the branch
+  Vector b;  // ∂F/∂p
   std::optional<OrbitProfile> profile;
-  double residual = 0.0;
-  int iterations = 0;  // of the corrector
-  int formed = 0;      // monodromies the corrector formed before it converged
+  int formed = 0;  // monodromies the corrector formed before it converged
+
+  Index n() const { return u.size() - 1; }
+  auto y() const { return u.head(u.size() - 1); }
+  double p() const { return u(u.size() - 1); }
 };
 
-// The chord corrector: a step must shrink the residual at least this much for the monodromy it
-// used to be kept, and a corrector takes at most kChordIterations steps per monodromy allowed.
-constexpr double kChordContraction = 0.25;
-constexpr int kChordIterations = 3;
-// The chord corrector's step control: the predictor's error (∞-norm, relative to max(1, |y|_∞))
-// below which the step grows by 1.5 and above which it shrinks by 0.6. On the 100-mass chain of
-// `pwl bench orbits` this covers θ from 1 to 3 in 199 points, where Newton's rule took 200 points
-// to reach 2.04, with the same grazings; 2e-5 and 2e-4 took 200 points to reach 1.43.
-constexpr double kGrowBelow = 2e-4;
-constexpr double kShrinkAbove = 2e-3;
+// ∂F/∂(y, p) of F = φ(y; p) − y: [M − I, b].
+Matrix orbit_jacobian(const Matrix& M, const Vector& b) {
+  const Index N = M.rows();
+  Matrix J(N, N + 1);
+  J.leftCols(N) = M - Matrix::Identity(N, N);
+  J.col(N) = b;
+  return J;
+}
+
 // Corrector::automatic takes the chord corrector above this many state components.
 constexpr Index kChordAbove = 20;
 // A bifurcation's trial points are closed to this residual (relative, as the shooting tolerance)
@@ -227,16 +198,16 @@ class Continuer {
     ShootingOptions shooting = options_.shooting;
     shooting.solver = ShootingSolver::dense;
     const PeriodicOrbit orbit = find_periodic_orbit(map, guess, shooting);
+    const Index N = orbit.state.size();
     Point first;
-    first.y = orbit.state;
-    first.p = options_.start;
+    first.u.resize(N + 1);
+    first.u << orbit.state, options_.start;
     first.M = orbit.monodromy;
     first.mu = orbit.multipliers;
     first.residual = orbit.residual;
     first.iterations = orbit.iterations;
-    first.b = parameter_derivative(first.y, first.p, options_.shooting.period);
+    first.b = parameter_derivative(orbit.state, options_.start, options_.shooting.period);
     // The first tangent: (M − I) z_y = −b z_p with z_p = 1, pointing toward `end`.
-    const Index N = first.y.size();
     Eigen::PartialPivLU<Matrix> lu(first.M - Matrix::Identity(N, N));
     Vector z(N + 1);
     z.head(N) = lu.solve(-first.b);
@@ -291,28 +262,59 @@ class Continuer {
     return (plus - minus) / (2 * delta);
   }
 
-  // The corrector from the prediction itself, with the monodromy `jacobian` of the point predicted
-  // from.
-  std::optional<Point> correct(const Vector& y_pred, double p_pred, const Vector& tau,
-                               const Vector& b, const Matrix* jacobian, int period) {
-    return correct_from(y_pred, p_pred, y_pred, p_pred, tau, b, period, jacobian,
+  // The orbit's equations F(y, p) = φ_kT(y; p) − y = 0 as a defining system of the core, in
+  // u = (y, p): its Jacobian [M − I, b] keeps the column b = ∂F/∂p it is given (a chord in that
+  // column: b comes from central differences, two integrations, at the accepted points), and the
+  // last monodromy it formed is kept for the multipliers.
+  class OrbitEquations : public DefiningSystem {
+   public:
+    OrbitEquations(Continuer& c, int period, const Vector& b) : c_(c), period_(period), b_(b) {}
+    Index state_size() const override { return b_.size(); }
+    bool evaluate(const Vector& u, Vector& G, Matrix* jacobian) override {
+      const Index N = b_.size();
+      const Vector y = u.head(N);
+      try {
+        if (jacobian != nullptr) {
+          G = c_.residual(y, u(N), period_, &M_);
+          *jacobian = orbit_jacobian(M_, b_);
+        } else {
+          G = c_.residual(y, u(N), period_, nullptr);
+        }
+      } catch (const Error&) {
+        return false;
+      }
+      return true;
+    }
+    bool admissible(const Vector& u) const override {
+      const double p = u(u.size() - 1);
+      std::string why;
+      return std::isfinite(p) && c_.model_.accepts(c_.options_.parameter, p, &why);
+    }
+    const Matrix& monodromy() const { return M_; }
+
+   private:
+    Continuer& c_;
+    int period_;
+    const Vector& b_;
+    Matrix M_;
+  };
+
+  // The corrector from the prediction itself, with the monodromy `monodromy` of the point
+  // predicted from.
+  std::optional<Point> correct(const Vector& prediction, const Vector& tau, const Vector& b,
+                               const Matrix* monodromy, int period) {
+    return correct_from(prediction, prediction, tau, b, period, monodromy,
                         options_.max_corrections);
   }
 
   // The tangent at a corrected point, oriented like `previous`.
   Vector tangent_at(const Point& pt, const Vector& previous) {
-    const Index N = pt.y.size();
-    Vector rhs = Vector::Zero(N + 1);
-    rhs(N) = 1.0;
-    Vector z = Eigen::PartialPivLU<Matrix>(bordered(pt.M, pt.b, previous)).solve(rhs);
-    z /= z.norm();
-    if (z.dot(previous) < 0) z = -z;
-    return z;
+    return curve_tangent(orbit_jacobian(pt.M, pt.b), previous);
   }
 
   const OrbitProfile& profile_of(Point& pt, int period) {
     if (!pt.profile) {
-      pt.profile = orbit_profile(map_at(pt.p), pt.y, period, options_.profile_samples);
+      pt.profile = orbit_profile(map_at(pt.p()), pt.y(), period, options_.profile_samples);
     }
     return *pt.profile;
   }
@@ -320,14 +322,14 @@ class Continuer {
   BranchPoint branch_point(Point& pt, int branch, int period, double arclength) {
     BranchPoint bp;
     bp.branch = branch;
-    bp.parameter = pt.p;
+    bp.parameter = pt.p();
     bp.arclength = arclength;
-    bp.orbit.state = pt.y;
+    bp.orbit.state = pt.y();
     bp.orbit.period = period;
-    bp.orbit.forcing_period = map_at(pt.p).forcing_period();
+    bp.orbit.forcing_period = map_at(pt.p()).forcing_period();
     bp.orbit.residual = pt.residual;
     bp.orbit.iterations = pt.iterations;
-    bp.orbit.exact_tangent = map_at(pt.p).exact_tangent();
+    bp.orbit.exact_tangent = map_at(pt.p()).exact_tangent();
     bp.orbit.solver = ShootingSolver::dense;
     bp.orbit.multipliers = pt.mu;
     bp.profile = profile_of(pt, period);
@@ -339,16 +341,117 @@ class Continuer {
     result_.notes.push_back(std::move(message));
   }
 
-  // Follows one branch from its first point.
+  static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+
+  // The walk of one branch on the core's loop: its corrector, the checks that end a switched
+  // branch (it rejoins its parent, or closes on itself), the events between its points, and the
+  // range.
+  class BranchWalk : public CurveWalk<Point> {
+   public:
+    BranchWalk(Continuer& c, int branch, int period, int parent_period, std::size_t source,
+               std::vector<Vector> first_orbit, double first_p)
+        : c_(c),
+          branch_(branch),
+          period_(period),
+          parent_period_(parent_period),
+          source_(source),
+          first_orbit_(std::move(first_orbit)),
+          first_p_(first_p),
+          label_(fmt::format("branch {} (period {})", branch, period)) {}
+
+    const std::string& label() const { return label_; }
+
+    std::optional<Point> corrected(const Point& from, const Vector& predicted) override {
+      std::optional<Point> next = c_.correct(predicted, from.tangent, from.b, &from.M, period_);
+      if (!next) return std::nullopt;
+      next->b = c_.parameter_derivative(next->y(), next->p(), period_);
+      next->tangent = c_.tangent_at(*next, from.tangent);
+      return next;
+    }
+
+    std::optional<std::string> stop_before(const Point& from, Point& to, double h,
+                                           int points) override {
+      const std::string& name = c_.options_.parameter.name();
+      // (Its own period doubling counts once the branch has gone some way: a loop of period-2k
+      // orbits may come back to where it started, as the other half of the same orbits.)
+      if (parent_period_ > 0 &&
+          c_.rejoins(from, to, h, parent_period_, points > 10 ? kNone : source_, branch_)) {
+        return fmt::format("{}: rejoined the period-{} branch at its period doubling near {} = "
+                           "{:.10g} after {} points",
+                           label_, parent_period_, name, to.p(), points);
+      }
+      if (parent_period_ > 0) {
+        Vector Fk;
+        try {
+          Fk = c_.residual(to.y(), to.p(), parent_period_, nullptr);
+        } catch (const Error&) {
+          Fk = Vector::Constant(1, std::numeric_limits<double>::infinity());
+        }
+        if (Fk.lpNorm<Eigen::Infinity>() <= 1e3 * c_.options_.shooting.tolerance *
+                                                 std::max(1.0, to.y().lpNorm<Eigen::Infinity>())) {
+          return fmt::format("{}: rejoined the period-{} branch near {} = {:.10g} (a period "
+                             "doubling of it) after {} points",
+                             label_, parent_period_, name, from.p(), points);
+        }
+      }
+      if (points > 10) {
+        // Closed: back at the first orbit, as the same state or as the same orbit started j
+        // periods later (a period-k orbit is k fixed points of the period-k map).
+        const Index N = to.n();
+        for (const Vector& start : first_orbit_) {
+          Vector gap(N + 1);
+          gap.head(N) = to.y() - start;
+          gap(N) = to.p() - first_p_;
+          if (gap.norm() < h) return fmt::format("{}: closed on itself after {} points", label_, points);
+        }
+      }
+      return std::nullopt;
+    }
+
+    std::optional<std::string> accept(Point& from, Point& to, double h, int points) override {
+      arclength_ += h;
+      c_.retracing_ = false;
+      c_.detect(from, to, h, branch_, period_);
+      if (c_.retracing_) {
+        return fmt::format("{}: stopped at {} = {:.10g} after {} points: it meets a bifurcation "
+                           "of its own again, so from here it retraces its orbits",
+                           label_, c_.options_.parameter.name(), to.p(), points);
+      }
+      c_.emit(c_.branch_point(to, branch_, period_, arclength_));
+      return std::nullopt;
+    }
+
+    std::optional<std::string> stop_after(const Point& point, int points) override {
+      const double margin = 1e-9 * (c_.hi_ - c_.lo_);
+      if (point.p() > c_.hi_ + margin || point.p() < c_.lo_ - margin) {
+        return fmt::format("{}: left the range at {} = {:.10g} after {} points", label_,
+                           c_.options_.parameter.name(), point.p(), points);
+      }
+      return std::nullopt;
+    }
+
+    double parameter_share(const Vector& tangent) const override {
+      return std::abs(tangent(tangent.size() - 1));
+    }
+    Index state_size() const override { return first_orbit_.front().size(); }
+
+   private:
+    Continuer& c_;
+    int branch_, period_, parent_period_;
+    std::size_t source_;
+    std::vector<Vector> first_orbit_;
+    double first_p_;
+    std::string label_;
+    double arclength_ = 0.0;
+  };
+
   // Follows one branch from its first point. A branch switched onto at a period doubling of a
   // period-`parent_period` branch stops where it rejoins that branch (its orbits become
   // period-`parent_period` ones: another period doubling of the parent) or closes on itself.
-  static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
   void follow(Point first, int branch, int period, int parent_period, std::size_t source) {
-    const std::string label = fmt::format("branch {} (period {})", branch, period);
-    const double first_p = first.p;
+    const double first_p = first.p();
     branch_start_ = first_p;
-    std::vector<Vector> first_orbit{first.y};
+    std::vector<Vector> first_orbit{first.y()};
     for (int j = 1; j < period; ++j) {
       try {
         first_orbit.push_back(map_at(first_p).advance(first_orbit.back(), 1));
@@ -356,132 +459,28 @@ class Continuer {
         break;
       }
     }
-    Point current = std::move(first);
-    double arclength = 0;
-    {
-      BranchPoint bp = branch_point(current, branch, period, arclength);
-      emit(bp);
-    }
-    double h = initial_step_;
-    int points = 1;
-    Vector previous_secant;
-    const double margin = 1e-9 * (hi_ - lo_);
-    while (true) {
-      if (points >= options_.max_points) {
-        note(fmt::format("{}: stopped after {} points (max points)", label, points));
-        return;
-      }
-      if (h < min_step_) {
-        note(fmt::format("{}: stopped at {} = {:.10g}: the step fell below {:.3g} (no orbit found "
-                         "ahead)",
-                         label, options_.parameter.name(), current.p, min_step_));
-        return;
-      }
-      const Index N = current.y.size();
-      const Vector y_pred = current.y + h * current.tangent.head(N);
-      const double p_pred = current.p + h * current.tangent(N);
-      std::optional<Point> next =
-          correct(y_pred, p_pred, current.tangent, current.b, &current.M, period);
-      if (!next) {
-        h /= 2;
-        continue;
-      }
-      next->b = parameter_derivative(next->y, next->p, period);
-      next->tangent = tangent_at(*next, current.tangent);
-      if (next->tangent.dot(current.tangent) < std::cos(30.0 * 3.141592653589793 / 180) &&
-          h > 4 * min_step_) {
-        h /= 2;
-        continue;
-      }
-      // A step that turns back on the previous one (the secants at more than 90°) has gone back
-      // along the branch, which happens at a sharp (non-smooth) turning point: shorter steps.
-      Vector secant(N + 1);
-      secant.head(N) = next->y - current.y;
-      secant(N) = next->p - current.p;
-      if (previous_secant.size() == secant.size() && secant.dot(previous_secant) < 0) {
-        if (h > 4 * min_step_) {
-          h /= 2;
-          continue;
-        }
+    emit(branch_point(first, branch, period, 0.0));
+    BranchWalk walk(*this, branch, period, parent_period, source, std::move(first_orbit),
+                    first_p);
+    const StepControl steps{initial_step_, min_step_, max_step_, chord_};
+    Point last;
+    const WalkEnd end = walk.walk(std::move(first), steps, options_.max_points, &last);
+    const std::string& name = options_.parameter.name();
+    switch (end.kind) {
+      case WalkEnd::Kind::max_points:
+        note(fmt::format("{}: stopped after {} points (max points)", walk.label(), end.points));
+        break;
+      case WalkEnd::Kind::min_step:
+        note(fmt::format("{}: stopped at {} = {:.10g}: the step fell below {:.3g} (no orbit "
+                         "found ahead)",
+                         walk.label(), name, last.p(), min_step_));
+        break;
+      case WalkEnd::Kind::turns_back:
         note(fmt::format("{}: stopped at {} = {:.10g} after {} points: the branch turns back "
                          "on itself there even at the smallest step",
-                         label, options_.parameter.name(), current.p, points));
-        return;
-      }
-      previous_secant = secant;
-      // (Its own period doubling counts once the branch has gone some way: a loop of period-2k
-      // orbits may come back to where it started, as the other half of the same orbits.)
-      if (parent_period > 0 &&
-          rejoins(current, *next, h, parent_period, points > 10 ? kNone : source, branch)) {
-        note(fmt::format("{}: rejoined the period-{} branch at its period doubling near {} = "
-                         "{:.10g} after {} points",
-                         label, parent_period, options_.parameter.name(), next->p, points));
-        return;
-      }
-      if (parent_period > 0) {
-        Vector Fk;
-        try {
-          Fk = residual(next->y, next->p, parent_period, nullptr);
-        } catch (const Error&) {
-          Fk = Vector::Constant(1, std::numeric_limits<double>::infinity());
-        }
-        if (Fk.lpNorm<Eigen::Infinity>() <=
-            1e3 * options_.shooting.tolerance * std::max(1.0, next->y.lpNorm<Eigen::Infinity>())) {
-          note(fmt::format("{}: rejoined the period-{} branch near {} = {:.10g} (a period "
-                           "doubling of it) after {} points",
-                           label, parent_period, options_.parameter.name(), current.p, points));
-          return;
-        }
-      }
-      if (points > 10) {
-        // Closed: back at the first orbit, as the same state or as the same orbit started j
-        // periods later (a period-k orbit is k fixed points of the period-k map).
-        for (const Vector& start : first_orbit) {
-          Vector gap(N + 1);
-          gap.head(N) = next->y - start;
-          gap(N) = next->p - first_p;
-          if (gap.norm() < h) {
-            note(fmt::format("{}: closed on itself after {} points", label, points));
-            return;
-          }
-        }
-      }
-      arclength += h;
-      ++points;
-      retracing_ = false;
-      detect(current, *next, h, branch, period);
-      if (retracing_) {
-        note(fmt::format("{}: stopped at {} = {:.10g} after {} points: it meets a bifurcation of "
-                         "its own again, so from here it retraces its orbits",
-                         label, options_.parameter.name(), next->p, points));
-        return;
-      }
-      BranchPoint bp = branch_point(*next, branch, period, arclength);
-      emit(bp);
-      // The predictor's error: how far the corrector moved the prediction, relative to the orbit.
-      const double predictor_error =
-          std::max((next->y - y_pred).lpNorm<Eigen::Infinity>(), std::abs(next->p - p_pred)) /
-          std::max(1.0, next->y.lpNorm<Eigen::Infinity>());
-      const int iterations = next->iterations;
-      current = std::move(*next);
-      if (current.p > hi_ + margin || current.p < lo_ - margin) {
-        note(fmt::format("{}: left the range at {} = {:.10g} after {} points", label,
-                         options_.parameter.name(), current.p, points));
-        return;
-      }
-      // The largest arclength step: max_step_ in the parameter, up to 100 max_step_ in all.
-      const double parameter_share = std::abs(current.tangent(current.tangent.size() - 1));
-      const double largest = max_step_ * std::min(1.0 / std::max(parameter_share, 1e-12), 100.0);
-      // Newton: the step grows after a corrector of two iterations or fewer and shrinks after
-      // five or more. The chord corrector converges linearly, at a rate set by how far the
-      // monodromy moved since the last point, so its iterations say little about the step: its
-      // step follows the predictor's error e instead, which grows like h² with the branch's
-      // curvature. It grows while e < kGrowBelow and shrinks where e > kShrinkAbove.
-      const bool easy = chord_ ? predictor_error < kGrowBelow : iterations <= 2;
-      const bool hard = chord_ ? predictor_error > kShrinkAbove : iterations >= 5;
-      if (easy) h = std::min(1.5 * h, largest);
-      h = std::min(h, largest);
-      if (hard) h *= 0.6;
+                         walk.label(), name, last.p(), end.points));
+        break;
+      case WalkEnd::Kind::problem: note(end.why); break;
     }
   }
 
@@ -490,10 +489,8 @@ class Continuer {
   // other half of the same loop). That period doubling is marked as switched onto this branch.
   bool rejoins(const Point& a, const Point& b, double h, int parent_period, std::size_t source,
                int branch) {
-    const Index N = a.y.size();
-    Vector ab(N + 1);
-    ab.head(N) = b.y - a.y;
-    ab(N) = b.p - a.p;
+    const Index N = a.n();
+    const Vector ab = b.u - a.u;
     const double length2 = ab.squaredNorm();
     for (std::size_t i = 0; i < result_.bifurcations.size(); ++i) {
       Bifurcation& bif = result_.bifurcations[i];
@@ -502,8 +499,8 @@ class Continuer {
         continue;
       }
       Vector ap(N + 1);
-      ap.head(N) = bif.state - a.y;
-      ap(N) = bif.parameter - a.p;
+      ap.head(N) = bif.state - a.y();
+      ap(N) = bif.parameter - a.p();
       const double w = length2 > 0 ? std::clamp(ap.dot(ab) / length2, 0.0, 1.0) : 0.0;
       const double distance = (ap - w * ab).norm();
       if (distance <= std::max(0.25 * h, 1e-7)) {
@@ -538,15 +535,12 @@ class Continuer {
             continue;
           }
           step_found_.push_back({BifurcationType::grazing, which,
-                                 locate(a, b, h, BifurcationType::grazing, which, period), a.p,
-                                 b.p});
+                                 locate(a, b, h, BifurcationType::grazing, which, period), a.p(),
+                                 b.p()});
         }
       }
     }
-    const Index N = a.y.size();
-    const auto along = [&](const Found& f) {
-      return a.tangent.head(N).dot(f.where.best.y - a.y) + a.tangent(N) * (f.where.best.p - a.p);
-    };
+    const auto along = [&](const Found& f) { return a.tangent.dot(f.where.best.u - a.u); };
     std::stable_sort(step_found_.begin(), step_found_.end(),
                      [&](const Found& x, const Found& y) { return along(x) < along(y); });
     for (const Found& f : step_found_) {
@@ -583,8 +577,8 @@ class Continuer {
       // A switched branch starts at a period doubling, where its own multiplier +1 is pinned: no
       // fold is taken within 1e-4 of the range from its start.
       const bool at_switch =
-          branch > 0 && std::max(std::abs(a.p - branch_start_), std::abs(b.p - branch_start_)) <=
-                            1e-4 * (hi_ - lo_);
+          branch > 0 && std::max(std::abs(a.p() - branch_start_),
+                                 std::abs(b.p() - branch_start_)) <= 1e-4 * (hi_ - lo_);
       return pinned(1.0) || at_switch ? Change::none : Change::fold;
     }
     if (std::abs(minus) == 1 && plus == 0 && pairs == 0) {
@@ -623,11 +617,11 @@ class Continuer {
       // where the crossing multiplier is within kPinned of ±1).
       if (found.located && signature(found.before->mu) == signature(a.mu) &&
           signature(found.after->mu) == signature(b.mu)) {
-        step_found_.push_back({type, -1, found, a.p, b.p});
+        step_found_.push_back({type, -1, found, a.p(), b.p()});
         return;
       }
       if (!found.located && !can_cut(s, depth)) {
-        step_found_.push_back({type, -1, found, a.p, b.p});
+        step_found_.push_back({type, -1, found, a.p(), b.p()});
         return;
       }
     }
@@ -637,15 +631,12 @@ class Continuer {
       note(fmt::format("between {} = {:.10g} and {:.10g} on branch {} the multipliers' signature "
                        "changes by more than one event that could not be told apart (the step "
                        "cannot be cut further); each kind of change located on the whole step",
-                       options_.parameter.name(), a.p, b.p, branch));
+                       options_.parameter.name(), a.p(), b.p(), branch));
       located_by_parity(a, b, s, period);
       return;
     }
     ++result_.step_cuts;
-    const Index N = a.y.size();
-    Vector to_b(N + 1);
-    to_b.head(N) = b.y - half->y;
-    to_b(N) = b.p - half->p;
+    const Vector to_b = b.u - half->u;
     explain_signature(a, *half, 0.5 * s, branch, period, depth + 1);
     explain_signature(*half, b, half->tangent.dot(to_b), branch, period, depth + 1);
   }
@@ -658,19 +649,15 @@ class Continuer {
   // The branch's point at half the arclength s from a toward b, corrected onto the branch along
   // a's tangent, with its multipliers, ∂F/∂p and tangent; empty where the corrector fails.
   std::optional<Point> point_between(Point& a, Point& b, double s, int period) {
-    const Index N = a.y.size();
-    const double half = 0.5 * s;
-    const Vector y_guess = 0.5 * (a.y + b.y);
-    const double p_guess = 0.5 * (a.p + b.p);
-    const Vector y_pred = a.y + half * a.tangent.head(N);
-    const double p_pred = a.p + half * a.tangent(N);
-    Matrix jacobian;
-    if (chord_) jacobian = 0.5 * (a.M + b.M);
-    std::optional<Point> pt =
-        correct_from(y_guess, p_guess, y_pred, p_pred, a.tangent, a.b, period,
-                     chord_ ? &jacobian : nullptr, options_.max_corrections + 3);
+    const Vector guess = 0.5 * (a.u + b.u);
+    const Vector prediction = a.u + (0.5 * s) * a.tangent;
+    Matrix monodromy;
+    if (chord_) monodromy = 0.5 * (a.M + b.M);
+    std::optional<Point> pt = correct_from(guess, prediction, a.tangent, a.b, period,
+                                           chord_ ? &monodromy : nullptr,
+                                           options_.max_corrections + 3);
     if (!pt) return std::nullopt;
-    pt->b = parameter_derivative(pt->y, pt->p, period);
+    pt->b = parameter_derivative(pt->y(), pt->p(), period);
     pt->tangent = tangent_at(*pt, a.tangent);
     return pt;
   }
@@ -689,7 +676,7 @@ class Continuer {
       types.push_back(BifurcationType::neimark_sacker);
     }
     for (const BifurcationType type : types) {
-      step_found_.push_back({type, -1, locate(a, b, s, type, -1, period), a.p, b.p});
+      step_found_.push_back({type, -1, locate(a, b, s, type, -1, period), a.p(), b.p()});
     }
   }
 
@@ -744,7 +731,6 @@ class Continuer {
   // grazing) between a and b, b at arclength h along a's tangent: the Illinois variant of regula
   // falsi on the arclength, every trial point corrected onto the branch.
   Located locate(Point& a, Point& b, double h, BifurcationType type, int which, int period) {
-    const Index N = a.y.size();
     double sa = 0, sb = h;
     int variant = 0;
     double fa = test_function(a, type, which, period, 0);
@@ -763,7 +749,7 @@ class Continuer {
     out.located = std::isfinite(fa) && std::isfinite(fb) && fa * fb <= 0;
     int side = 0;  // Illinois: which end was kept last
     for (int it = 0; out.located && it < 80; ++it) {
-      if (std::abs(end_b.p - end_a.p) <= options_.locate_tolerance &&
+      if (std::abs(end_b.p() - end_a.p()) <= options_.locate_tolerance &&
           std::abs(sb - sa) <= 1e-6 * std::abs(h)) {
         break;
       }
@@ -772,20 +758,18 @@ class Continuer {
       if (!(s > std::min(sa, sb) && s < std::max(sa, sb))) s = 0.5 * (sa + sb);
       // Predict by interpolating the bracket's ends, constrain to a's tangent at arclength s.
       const double w = (s - sa) / (sb - sa);
-      const Vector y_guess = (1 - w) * end_a.y + w * end_b.y;
-      const double p_guess = (1 - w) * end_a.p + w * end_b.p;
-      const Vector y_pred = a.y + s * a.tangent.head(N);
-      const double p_pred = a.p + s * a.tangent(N);
+      const Vector guess = (1 - w) * end_a.u + w * end_b.u;
+      const Vector prediction = a.u + s * a.tangent;
       // The chord corrector starts from the monodromy interpolated like the guess.
-      Matrix jacobian;
+      Matrix monodromy;
       if (chord_) {
         const double along = std::clamp(s / h, 0.0, 1.0);
-        jacobian = (1 - along) * a.M + along * b.M;
+        monodromy = (1 - along) * a.M + along * b.M;
       }
       std::optional<Point> pt =
-          correct_from(y_guess, p_guess, y_pred, p_pred, a.tangent, a.b, period,
-                       chord_ ? &jacobian : nullptr, options_.max_corrections + 3,
-                       type != BifurcationType::grazing, kLocateResidual);
+          correct_from(guess, prediction, a.tangent, a.b, period, chord_ ? &monodromy : nullptr,
+                       options_.max_corrections + 3, type != BifurcationType::grazing,
+                       kLocateResidual);
       if (!pt) {
         out.located = false;
         break;
@@ -827,8 +811,8 @@ class Continuer {
     bif.type = type;
     bif.branch = branch;
     bif.period = period;
-    bif.parameter = best.p;
-    bif.state = best.y;
+    bif.parameter = best.p();
+    bif.state = best.y();
     bif.test_value = found.test_value;
     if (type == BifurcationType::fold) bif.multiplier = nearest_real(best.mu, 1.0);
     if (type == BifurcationType::period_doubling) bif.multiplier = nearest_real(best.mu, -1.0);
@@ -852,7 +836,7 @@ class Continuer {
     if (!found.located) {
       note(fmt::format("{} near {} = {:.10g} on branch {}: detected, not located (bracket {:.10g} "
                        "to {:.10g})",
-                       bifurcation_name(type), options_.parameter.name(), best.p, branch, from,
+                       bifurcation_name(type), options_.parameter.name(), best.p(), branch, from,
                        to));
     }
     result_.bifurcations.push_back(bif);
@@ -868,148 +852,53 @@ class Continuer {
     return std::abs(x) < std::abs(y);
   }
 
-  // The corrector: F(y, p) = 0 with the constraint τ · ((y, p) − (y_pred, p_pred)) = 0, solved
-  // from (y_guess, p_guess). `b` is ∂F/∂p near the prediction (kept fixed: a chord in that
-  // column). Empty when it does not converge or the motion blows up.
+  // The corrector: F(y, p) = 0 with the constraint τ · (u − prediction) = 0 in u = (y, p), solved
+  // from `guess` on the core (correct_on_curve). `b` is ∂F/∂p near the prediction (kept fixed: a
+  // chord in that column). Empty when it does not converge or the motion blows up.
   //
   // Newton forms the monodromy at every iterate. The Newton-chord corrector (the default above
-  // 20 state components; Y. A. Kuznetsov 2004, §10.2.2; Allgower and Georg 2003, ch. 2) keeps
-  // the monodromy `jacobian` of a point nearby (the point predicted from, or between the two ends
-  // of a bifurcation's bracket the monodromy interpolated like the guess) while the residual falls
-  // at least kChordContraction a step. Where it does not, the monodromy is formed afresh, at the
-  // last iterate if the step made the residual larger and at the new one otherwise (at the first
-  // one when there is no `jacobian`). Forming the monodromy integrates the map with all its
-  // tangent columns, many times the cost of one integration, so a corrector forms it about once,
-  // at the orbit it converges to, where its multipliers are wanted. The orbit found is the one
-  // Newton finds, to the same tolerance: only the path to it differs. `corrections` bounds the
-  // monodromies formed before convergence. Without `multipliers` (a grazing's trial points, whose
-  // test function is the orbit's profile) the chord corrector leaves the orbit's monodromy and
-  // multipliers out. A `polish` below the shooting tolerance (a bifurcation's trial points) closes
-  // the orbit further: to `polish`, or, past the shooting tolerance, while each step shrinks the
-  // residual kChordContraction-fold (to the rounding floor, or until a chord step contracts more
-  // slowly). It returns the best iterate within the shooting tolerance where polishing ends on a
-  // worse one or runs out of monodromies or steps.
-  std::optional<Point> correct_from(const Vector& y_guess, double p_guess, const Vector& y_pred,
-                                    double p_pred, const Vector& tau, const Vector& b, int period,
-                                    const Matrix* jacobian, int corrections,
+  // 20 state components) keeps the monodromy `monodromy` of a point nearby (the point predicted
+  // from, or between the two ends of a bifurcation's bracket the monodromy interpolated like the
+  // guess) while the residual falls at least fourfold a step. Forming the monodromy integrates
+  // the map with all its tangent columns, many times the cost of one integration, so a corrector
+  // forms it about once, at the orbit it converges to, where its multipliers are wanted. The orbit
+  // found is the one Newton finds, to the same tolerance: only the path to it differs.
+  // `corrections` bounds the monodromies formed before convergence. Without `multipliers` (a
+  // grazing's trial points, whose test function is the orbit's profile) the chord corrector
+  // leaves the orbit's monodromy and multipliers out. A `polish` below the shooting tolerance (a
+  // bifurcation's trial points) closes the orbit further (CorrectorSettings::polish).
+  std::optional<Point> correct_from(const Vector& guess, const Vector& prediction,
+                                    const Vector& tau, const Vector& b, int period,
+                                    const Matrix* monodromy, int corrections,
                                     bool multipliers = true, double polish = 0.0) {
-    const double tolerance = options_.shooting.tolerance;
-    if (!(polish > 0.0) || polish > tolerance) polish = tolerance;
-    const Index N = y_guess.size();
+    OrbitEquations equations(*this, period, b);
+    Matrix start;
+    if (chord_ && monodromy != nullptr) start = orbit_jacobian(*monodromy, b);
+    CorrectorSettings settings;
+    settings.chord = chord_;
+    settings.corrections = corrections;
+    settings.tolerance = options_.shooting.tolerance;
+    settings.polish = polish;
+    settings.jacobian_at_solution = multipliers;
+    std::optional<CorrectedPoint> c =
+        correct_on_curve(equations, guess, prediction, tau, start.size() > 0 ? &start : nullptr,
+                         settings, &result_.chord_stalls);
+    if (!c) return std::nullopt;
     Point pt;
-    pt.y = y_guess;
-    pt.p = p_guess;
-    Eigen::PartialPivLU<Matrix> lu;
-    bool factored = chord_ && jacobian != nullptr;
-    if (factored) lu.compute(bordered(*jacobian, b, tau));
-    double previous = std::numeric_limits<double>::infinity();
-    Vector last_y = pt.y;  // the iterate whose residual is `previous`
-    double last_p = pt.p;
-    Vector F;
-    // F at the iterate, with the monodromy there or without; false where the motion blows up.
-    const auto integrate = [&](bool with_monodromy) {
-      try {
-        F = residual(pt.y, pt.p, period, with_monodromy ? &pt.M : nullptr);
-      } catch (const Error&) {
-        return false;
-      }
-      return F.allFinite();
-    };
-    const auto constraint_at = [&] {
-      return tau.head(N).dot(pt.y - y_pred) + tau(N) * (pt.p - p_pred);
-    };
-    // While polishing: the iterate with the smallest residual among those already within the
-    // shooting tolerance (and on the constraint). Returned when polishing ends on a worse one or
-    // runs out of monodromies or steps, so that polishing never loses an orbit the tolerance
-    // accepts.
-    struct Within {
-      Vector y;
-      double p = 0.0, res = 0.0;
-      int it = 0;
-    };
-    std::optional<Within> within;
-    const auto fall_back = [&]() -> std::optional<Point> {
-      if (!within) return std::nullopt;
-      pt.y = within->y;
-      pt.p = within->p;
-      pt.iterations = within->it;
-      pt.residual = within->res;
-      pt.M.resize(0, 0);
-      if (!multipliers) return pt;
-      if (!integrate(true)) return std::nullopt;
-      pt.residual = F.lpNorm<Eigen::Infinity>();
+    pt.u = std::move(c->u);
+    pt.residual = c->residual;
+    pt.iterations = c->iterations;
+    pt.formed = c->formed;
+    if (c->jacobian.size() > 0) {
+      pt.M = equations.monodromy();
       pt.mu = floquet_multipliers(pt.M);
-      return pt;
-    };
-    for (int it = 0; it <= kChordIterations * corrections; ++it) {
-      // The monodromy is formed here when there is none yet or the last chord step did not
-      // contract; otherwise only the map is integrated.
-      bool formed = !factored || !chord_;
-      if (!integrate(formed)) return fall_back();
-      double res = F.lpNorm<Eigen::Infinity>();
-      double constraint = constraint_at();
-      const double scale = std::max(1.0, pt.y.lpNorm<Eigen::Infinity>());
-      const bool on_constraint = std::abs(constraint) <= 1e-12 * scale;
-      const bool closed =
-          res <= polish * scale ||
-          (res <= tolerance * scale && !(res <= kChordContraction * previous));
-      if (closed && on_constraint && within && within->res < res) return fall_back();
-      if (polish < tolerance && res <= tolerance * scale && on_constraint &&
-          !(within && within->res <= res)) {
-        within = Within{pt.y, pt.p, res, it};
-      }
-      if (closed && on_constraint) {
-        pt.iterations = it;
-        if (!formed && !multipliers) {
-          pt.residual = res;
-          pt.M.resize(0, 0);
-          return pt;
-        }
-        // The monodromy at the orbit, for its multipliers (the same integration, with tangent).
-        if (!formed && !integrate(true)) return std::nullopt;
-        pt.residual = F.lpNorm<Eigen::Infinity>();
-        pt.mu = floquet_multipliers(pt.M);
-        return pt;
-      }
-      if (!formed && !(res <= kChordContraction * previous)) {
-        // The chord step stalled: the monodromy here, or back where the step started if it made
-        // the residual larger.
-        if (!(res <= previous)) {
-          pt.y = last_y;
-          pt.p = last_p;
-          constraint = constraint_at();
-        }
-        if (!integrate(true)) return fall_back();
-        res = F.lpNorm<Eigen::Infinity>();
-        formed = true;
-        ++result_.chord_stalls;
-      }
-      if (formed) {
-        if (pt.formed++ >= corrections) return fall_back();
-        lu.compute(bordered(pt.M, b, tau));
-        factored = true;
-      }
-      previous = res;
-      last_y = pt.y;
-      last_p = pt.p;
-      Vector rhs(N + 1);
-      rhs.head(N) = -F;
-      rhs(N) = -constraint;
-      const Vector d = lu.solve(rhs);
-      if (!d.allFinite()) return fall_back();
-      pt.y += d.head(N);
-      pt.p += d(N);
-      std::string why;
-      if (!std::isfinite(pt.p) || !model_.accepts(options_.parameter, pt.p, &why)) {
-        return fall_back();
-      }
     }
-    return fall_back();
+    return pt;
   }
 
   void switch_branch(Pending& pd) {
     const int period = 2 * pd.period;
-    const Index N = pd.at.y.size();
+    const Index N = pd.at.n();
     // The eigenvector of the multiplier nearest −1.
     Eigen::EigenSolver<Matrix> eig(pd.at.M);
     Index k = 0;
@@ -1020,28 +909,29 @@ class Continuer {
     v /= v.norm();
     Vector tau0 = Vector::Zero(N + 1);
     tau0.head(N) = v;
-    const double scale = std::max(1.0, pd.at.y.norm());
-    const Vector b0 = parameter_derivative(pd.at.y, pd.at.p, period);
+    const double scale = std::max(1.0, pd.at.y().norm());
+    const Vector b0 = parameter_derivative(pd.at.y(), pd.at.p(), period);
     for (double eps : {1e-3, 1e-2, 3e-2, 1e-4}) {
-      const Vector y_pred = pd.at.y + eps * scale * v;
+      Vector prediction = pd.at.u;
+      prediction.head(N) += eps * scale * v;
       // No monodromy to start from: the period-2k one at the period doubling, M², makes the
       // bordered matrix singular there (M² − I has v in its kernel, and ∂F/∂p lies in its range:
       // a pitchfork of the period-2k map), so the first is formed at y* + ε v.
-      std::optional<Point> pt = correct_from(y_pred, pd.at.p, y_pred, pd.at.p, tau0, b0, period,
-                                             nullptr, options_.max_corrections + 3);
+      std::optional<Point> pt = correct_from(prediction, prediction, tau0, b0, period, nullptr,
+                                             options_.max_corrections + 3);
       if (!pt) continue;
       // A genuine period-2k orbit: not a fixed point of the period-k map.
       Vector Fk;
       try {
-        Fk = residual(pt->y, pt->p, pd.period, nullptr);
+        Fk = residual(pt->y(), pt->p(), pd.period, nullptr);
       } catch (const Error&) {
         continue;
       }
       if (Fk.lpNorm<Eigen::Infinity>() <=
-          1e3 * options_.shooting.tolerance * std::max(1.0, pt->y.lpNorm<Eigen::Infinity>())) {
+          1e3 * options_.shooting.tolerance * std::max(1.0, pt->y().lpNorm<Eigen::Infinity>())) {
         continue;
       }
-      pt->b = parameter_derivative(pt->y, pt->p, period);
+      pt->b = parameter_derivative(pt->y(), pt->p(), period);
       pt->tangent = tangent_at(*pt, tau0);
       ++branches_;
       result_.bifurcations[pd.bifurcation].to_branch = branches_;
@@ -1056,32 +946,31 @@ class Continuer {
     shooting.solver = ShootingSolver::dense;
     for (double delta : {1e-4 * range, 1e-3 * range, 1e-2 * range}) {
       for (double side : {1.0, -1.0}) {
-        const double p = pd.at.p + side * delta;
+        const double p = pd.at.p() + side * delta;
         std::string why;
         if (p < lo_ || p > hi_ || !model_.accepts(options_.parameter, p, &why)) continue;
         for (double eps : {1.0, 3.0, 10.0, 30.0}) {
-          const Vector guess = pd.at.y + eps * std::sqrt(delta) * scale * v;
+          const Vector guess = pd.at.y() + eps * std::sqrt(delta) * scale * v;
           Point pt;
           try {
             const PeriodicOrbit orbit = find_periodic_orbit(map_at(p), guess, shooting);
-            pt.y = orbit.state;
+            pt.u.resize(N + 1);
+            pt.u << orbit.state, p;
             pt.M = orbit.monodromy;
             pt.mu = orbit.multipliers;
             pt.residual = orbit.residual;
             pt.iterations = orbit.iterations;
-            const Vector Fk = residual(pt.y, p, pd.period, nullptr);
+            const Vector Fk = residual(orbit.state, p, pd.period, nullptr);
             if (Fk.lpNorm<Eigen::Infinity>() <=
-                1e3 * options_.shooting.tolerance * std::max(1.0, pt.y.lpNorm<Eigen::Infinity>())) {
+                1e3 * options_.shooting.tolerance *
+                    std::max(1.0, orbit.state.lpNorm<Eigen::Infinity>())) {
               continue;  // the period-k orbit again
             }
           } catch (const Error&) {
             continue;
           }
-          pt.p = p;
-          pt.b = parameter_derivative(pt.y, pt.p, period);
-          Vector away(N + 1);
-          away.head(N) = pt.y - pd.at.y;
-          away(N) = pt.p - pd.at.p;
+          pt.b = parameter_derivative(pt.y(), pt.p(), period);
+          const Vector away = pt.u - pd.at.u;
           pt.tangent = tangent_at(pt, away / away.norm());
           ++branches_;
           result_.bifurcations[pd.bifurcation].to_branch = branches_;
@@ -1092,7 +981,7 @@ class Continuer {
     }
     note(fmt::format("branch switching at the period doubling at {} = {:.10g}: no period-{} orbit "
                      "found next to it",
-                     options_.parameter.name(), pd.at.p, period));
+                     options_.parameter.name(), pd.at.p(), period));
   }
 
   const analysis::PointModel& model_;

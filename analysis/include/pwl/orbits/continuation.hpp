@@ -61,6 +61,7 @@
 #include <string>
 #include <vector>
 
+#include "pwl/orbits/arclength_continuation.hpp"
 #include "pwl/orbits/orbit_profile.hpp"
 #include "pwl/orbits/periodic_orbit.hpp"
 #include "pwl/study/point_model.hpp"
@@ -68,11 +69,6 @@
 namespace pwl::orbits {
 
 enum class BifurcationType { fold, period_doubling, neimark_sacker, grazing };
-enum class Corrector { automatic, chord, newton };
-// "automatic", "chord", "newton"; parse_corrector throws InputError naming the value for any
-// other text.
-std::string corrector_name(Corrector corrector);
-Corrector parse_corrector(const std::string& name);
 // "fold", "period-doubling", "neimark-sacker", "grazing".
 std::string bifurcation_name(BifurcationType type);
 
