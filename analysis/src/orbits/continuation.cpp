@@ -480,6 +480,7 @@ class Continuer {
                          "on itself there even at the smallest step",
                          walk.label(), name, last.p(), end.points));
         break;
+      case WalkEnd::Kind::stalled:  // not asked for (StepControl::stall_steps is 0)
       case WalkEnd::Kind::problem: note(end.why); break;
     }
   }
@@ -731,7 +732,6 @@ class Continuer {
   // grazing) between a and b, b at arclength h along a's tangent: the Illinois variant of regula
   // falsi on the arclength, every trial point corrected onto the branch.
   Located locate(Point& a, Point& b, double h, BifurcationType type, int which, int period) {
-    double sa = 0, sb = h;
     int variant = 0;
     double fa = test_function(a, type, which, period, 0);
     double fb = test_function(b, type, which, period, 0);
@@ -742,20 +742,8 @@ class Continuer {
       fa = test_function(a, type, which, period, v);
       fb = test_function(b, type, which, period, v);
     }
-    Located out;
-    out.best = fabs_less(fa, fb) ? a : b;
-    out.test_value = fabs_less(fa, fb) ? fa : fb;
-    Point end_a = a, end_b = b;  // the bracket's ends, at sa and sb
-    out.located = std::isfinite(fa) && std::isfinite(fb) && fa * fb <= 0;
-    int side = 0;  // Illinois: which end was kept last
-    for (int it = 0; out.located && it < 80; ++it) {
-      if (std::abs(end_b.p() - end_a.p()) <= options_.locate_tolerance &&
-          std::abs(sb - sa) <= 1e-6 * std::abs(h)) {
-        break;
-      }
-      if (std::abs(sb - sa) <= 1e-13 * std::abs(h)) break;
-      double s = sb - fb * (sb - sa) / (fb - fa);
-      if (!(s > std::min(sa, sb) && s < std::max(sa, sb))) s = 0.5 * (sa + sb);
+    const auto trial = [&](double s, const Point& end_a, double sa, const Point& end_b,
+                           double sb) -> std::optional<std::pair<Point, double>> {
       // Predict by interpolating the bracket's ends, constrain to a's tangent at arclength s.
       const double w = (s - sa) / (sb - sa);
       const Vector guess = (1 - w) * end_a.u + w * end_b.u;
@@ -770,36 +758,21 @@ class Continuer {
           correct_from(guess, prediction, a.tangent, a.b, period, chord_ ? &monodromy : nullptr,
                        options_.max_corrections + 3, type != BifurcationType::grazing,
                        kLocateResidual);
-      if (!pt) {
-        out.located = false;
-        break;
-      }
+      if (!pt) return std::nullopt;
       const double f = test_function(*pt, type, which, period, variant);
-      if (!std::isfinite(f)) {
-        out.located = false;
-        break;
-      }
-      if (std::abs(f) < std::abs(out.test_value)) {
-        out.best = *pt;
-        out.test_value = f;
-      }
-      if (f * fb < 0) {
-        sa = sb, fa = fb;
-        end_a = std::move(end_b);
-        side = 0;
-      } else {
-        if (side == 1) fa /= 2;  // Illinois
-        side = 1;
-      }
-      sb = s, fb = f;
-      end_b = std::move(*pt);
-      if (f == 0) break;
-    }
-    if (sa <= sb) {
-      out.before = std::move(end_a), out.after = std::move(end_b);
-    } else {
-      out.before = std::move(end_b), out.after = std::move(end_a);
-    }
+      return std::pair<Point, double>{std::move(*pt), f};
+    };
+    const auto small = [&](const Point& end_a, double sa, const Point& end_b, double sb) {
+      return std::abs(end_b.p() - end_a.p()) <= options_.locate_tolerance &&
+             std::abs(sb - sa) <= 1e-6 * std::abs(h);
+    };
+    ArclengthZero<Point> zero = zero_on_arclength(a, fa, b, fb, h, trial, small);
+    Located out;
+    out.best = std::move(zero.best);
+    out.test_value = zero.value;
+    out.located = zero.located;
+    out.before = std::move(zero.before);
+    out.after = std::move(zero.after);
     return out;
   }
 
@@ -844,12 +817,6 @@ class Continuer {
     if (type == BifurcationType::period_doubling && options_.switch_branches && found.located) {
       pending_.push_back({best, period, result_.bifurcations.size() - 1});
     }
-  }
-
-  static bool fabs_less(double x, double y) {
-    if (!std::isfinite(y)) return true;
-    if (!std::isfinite(x)) return false;
-    return std::abs(x) < std::abs(y);
   }
 
   // The corrector: F(y, p) = 0 with the constraint τ · (u − prediction) = 0 in u = (y, p), solved

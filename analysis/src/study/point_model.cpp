@@ -246,6 +246,36 @@ PointModel PointModel::with(const SweepParameter& p, double value) const {
                                       structure_->source, structure_->label});
 }
 
+double PointModel::value(const SweepParameter& p) const {
+  std::string why;
+  if (!has(p, &why)) throw InputError(why);
+  const auto single = [&](const std::vector<double>& values) {
+    for (double v : values) {
+      if (v != values.front()) {
+        throw InputError(fmt::format("{}: the masses have different values ({} and {}); a curve "
+                                     "in {} needs one",
+                                     p.name(), values.front(), v, p.name()));
+      }
+    }
+    return values.front();
+  };
+  const auto index = static_cast<std::size_t>(p.index());
+  switch (p.kind()) {
+    case SweepParameter::Kind::theta: return chain_.theta;
+    case SweepParameter::Kind::alpha: return single(chain_.alpha);
+    case SweepParameter::Kind::zeta: return chain_.zeta;
+    case SweepParameter::Kind::gap: return single(chain_.gap);
+    case SweepParameter::Kind::amplitude: return 1.0;
+    case SweepParameter::Kind::spring_stiffness:
+      return structure_->structure.springs[index].stiffness;
+    case SweepParameter::Kind::spring_gap: return structure_->structure.springs[index].gap;
+    case SweepParameter::Kind::load_amplitude: return structure_->structure.loads[index].amplitude;
+    case SweepParameter::Kind::load_frequency: return structure_->structure.loads[index].omega;
+    case SweepParameter::Kind::damping: return 1.0;
+  }
+  return 0.0;
+}
+
 PointCase PointModel::point_case() const {
   if (!structure_) return PointCase(chain_);
   structure_->structure.validate();

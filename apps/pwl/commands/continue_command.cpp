@@ -20,6 +20,7 @@
 #include "commands/cli_checks.hpp"
 #include "commands/commands.hpp"
 #include "commands/continue_command.hpp"
+#include "commands/curve_outputs.hpp"
 #include "commands/flag_relations.hpp"
 #include "commands/orbit_options.hpp"
 #include "commands/step_guard_report.hpp"
@@ -27,6 +28,7 @@
 #include "commands/sweep_command.hpp"
 #include "output/gnuplot.hpp"
 #include "output/csv_writer.hpp"
+#include "parallel/stop_signals.hpp"
 #include "pwl/errors.hpp"
 #include "pwl/orbits/continuation.hpp"
 #include "pwl/orbits/orbit_profile.hpp"
@@ -61,32 +63,6 @@ std::vector<int> recorded_dofs(const std::vector<std::string>& record, int n) {
   return dofs;
 }
 
-// A CSV file written a row at a time and flushed after each, so that a run that is interrupted
-// keeps every row it computed.
-class FlushedCsv {
- public:
-  FlushedCsv(const std::string& path, const std::vector<std::string>& columns)
-      : file_(std::fopen(path.c_str(), "w")), path_(path) {
-    if (file_ == nullptr) throw Error(fmt::format("cannot write {}", path));
-    fmt::print(file_, "{}\n", fmt::join(columns, ","));
-    std::fflush(file_);
-  }
-  ~FlushedCsv() {
-    if (file_ != nullptr) std::fclose(file_);
-  }
-  FlushedCsv(const FlushedCsv&) = delete;
-  FlushedCsv& operator=(const FlushedCsv&) = delete;
-  void row(const std::string& text) {
-    fmt::print(file_, "{}\n", text);
-    if (std::fflush(file_) != 0) throw Error(fmt::format("cannot write {}", path_));
-  }
-
- private:
-  std::FILE* file_;
-  std::string path_;
-};
-
-
 // Appends ",field" to a CSV row.
 void add_field(std::string& row, const std::string& field) {
   row += ',';
@@ -100,7 +76,8 @@ class ContinueOutputs : public orbits::ContinuationObserver {
   ContinueOutputs(const std::string& folder, const analysis::PointModel& model,
                   const analysis::SweepParameter& parameter, const OrbitMethod& method,
                   std::vector<int> dofs, bool progress)
-      : model_(model),
+      : folder_(folder),
+        model_(model),
         parameter_(parameter),
         method_(method),
         dofs_(std::move(dofs)),
@@ -174,6 +151,7 @@ class ContinueOutputs : public orbits::ContinuationObserver {
       first_iterations_ = orbit.iterations;
     }
     show(p);
+    stop_on_signal(folder_);
   }
 
   void bifurcation(const orbits::Bifurcation& b) override {
@@ -258,6 +236,7 @@ class ContinueOutputs : public orbits::ContinuationObserver {
     std::fflush(stderr);
   }
 
+  std::string folder_;
   const analysis::PointModel& model_;
   analysis::SweepParameter parameter_;
   OrbitMethod method_;
@@ -428,6 +407,8 @@ void continue_orbit(const ContinueFlags& f) {
                  ? fmt::format("the state {} forcing periods after {}", o.transient, o.run.start.text())
                  : o.guess_file);
   std::filesystem::create_directories(o.out);
+  // SIGINT and SIGTERM stop the run between two rows, every row written whole.
+  const StopSignals signals;
   ContinueOutputs outputs(o.out, base, parameter, method, dofs, !o.quiet);
   orbits::ContinuationResult result;
   try {
@@ -463,6 +444,32 @@ void continue_orbit(const ContinueFlags& f) {
   if (!f.no_plot) {
     draw_frequency_response(f, outputs, result.bifurcations, dofs, parameter,
                             !base.explicit_structure(), title);
+  }
+  if (problem.curves) {
+    const auto begin = std::chrono::steady_clock::now();
+    const std::vector<orbits::Bifurcation> starts =
+        curve_starts(problem, result.bifurcations);
+    CurveOutputs curve_outputs(o.out, *problem.curves, n, !o.quiet);
+    orbits::CurvesResult curves;
+    try {
+      curves = orbits::follow_bifurcation_curves(base, starts, *problem.curves, &curve_outputs);
+    } catch (...) {
+      curve_outputs.finish_progress();
+      throw;
+    }
+    curve_outputs.finish_progress();
+    print_curves(curves, *problem.curves);
+    if (!curves.notes.empty()) {
+      fmt::print("curve notes:\n");
+      for (const std::string& note : curves.notes) fmt::print("  {}\n", note);
+    }
+    fmt::print("curves' work: {} monodromies, {} other integrations of the map\n",
+               curves.monodromies, curves.integrations);
+    fmt::print("curves' time: {:.2f} s ({} rows)\n",
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count(),
+               curve_outputs.rows());
+    fmt::print("wrote {0}/curves.csv and {0}/codim2.csv\n", o.out);
+    if (!f.no_plot) draw_curves(o.out, *problem.curves, curves, title);
   }
   if (f.over_sweep > 0) {
     run_over_sweep(f, base, parameter, method, from, to, dofs, result.bifurcations, title);
@@ -544,7 +551,102 @@ ContinuationProblem continuation_problem(const ContinueFlags& f) {
   c.shooting.solver = orbits::ShootingSolver::dense;
   if (!c.is_valid(&why)) throw InputError(why);
 
-  return {base, parameter, from, to, dofs, first_case, method, c};
+  ContinuationProblem problem{base, parameter, from, to, dofs, first_case, method, c, {}, 0};
+  if (f.curves.empty()) {
+    if (!f.curve_types.empty() || f.start_bifurcation != 0) {
+      throw InputError(fmt::format("{} needs --curves Q=FROM:TO",
+                                   f.curve_types.empty() ? "--start-bifurcation" : "--curve-types"));
+    }
+    return problem;
+  }
+  const std::size_t equals = f.curves.find('=');
+  if (equals == std::string::npos) {
+    throw InputError(fmt::format("--curves = \"{}\": give the second parameter and its range as "
+                                 "Q=FROM:TO (alpha=1:15)",
+                                 f.curves));
+  }
+  orbits::CurvesOptions curves;
+  curves.first = parameter;
+  curves.second = parse_model_parameter(base, "--curves", f.curves.substr(0, equals));
+  check_relation("continue", "--curves", curves.second.name(), "--parameter", parameter.name());
+  parse_range("--curves", f.curves.substr(equals + 1), &curves.q_from, &curves.q_to);
+  if (!std::isfinite(curves.q_from) || !std::isfinite(curves.q_to) ||
+      curves.q_from == curves.q_to) {
+    throw InputError(fmt::format("--curves = \"{}\": the two ends must be different finite values",
+                                 f.curves));
+  }
+  for (const double end : {curves.q_from, curves.q_to}) {
+    if (!base.accepts(curves.second, end, &why)) {
+      throw InputError(fmt::format("--curves = \"{}\": at {} = {}: {}", f.curves,
+                                   curves.second.name(), end, why));
+    }
+  }
+  double q0 = 0.0;
+  try {
+    q0 = base.value(curves.second);
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("--curves = \"{}\": {}", f.curves, e.what()));
+  }
+  if (!(q0 >= std::min(curves.q_from, curves.q_to) && q0 <= std::max(curves.q_from, curves.q_to))) {
+    throw InputError(fmt::format("--curves = \"{}\": the branch is at {} = {}, outside that range "
+                                 "(the curves start on the branch)",
+                                 f.curves, curves.second.name(), q0));
+  }
+  if (!f.curve_types.empty()) {
+    curves.types.clear();
+    for (const std::string& name : f.curve_types) {
+      try {
+        curves.types.push_back(orbits::parse_curve_type(name));
+      } catch (const InputError& e) {
+        throw InputError(fmt::format("--curve-types {}: {}", name, e.what()));
+      }
+    }
+  }
+  curves.p_from = from;
+  curves.p_to = to;
+  curves.max_points = f.curve_points;
+  curves.corrector = c.corrector;
+  curves.method = c.method;
+  curves.steps_per_period = c.steps_per_period;
+  curves.shooting = c.shooting;
+  curves.profile_samples = c.profile_samples;
+  if (!curves.is_valid(&why)) throw InputError("--curves: " + why);
+  problem.curves = curves;
+  problem.start_bifurcation = f.start_bifurcation;
+  return problem;
+}
+
+std::vector<orbits::Bifurcation> curve_starts(const ContinuationProblem& problem,
+                                              const std::vector<orbits::Bifurcation>& found) {
+  if (!problem.curves) return {};
+  const auto wanted = [&](const orbits::Bifurcation& b) {
+    const auto& types = problem.curves->types;
+    return std::find(types.begin(), types.end(), orbits::curve_type_of(b.type)) != types.end();
+  };
+  if (problem.start_bifurcation == 0) {
+    std::vector<orbits::Bifurcation> starts;
+    for (const orbits::Bifurcation& b : found) {
+      if (wanted(b)) starts.push_back(b);
+    }
+    return starts;
+  }
+  const auto row = static_cast<std::size_t>(problem.start_bifurcation);
+  if (row > found.size()) {
+    throw InputError(fmt::format("--start-bifurcation {}: bifurcations.csv has {} row(s)", row,
+                                 found.size()));
+  }
+  const orbits::Bifurcation& b = found[row - 1];
+  if (!b.located) {
+    throw InputError(fmt::format("--start-bifurcation {}: that {} was detected, not located: no "
+                                 "curve starts there",
+                                 row, orbits::bifurcation_name(b.type)));
+  }
+  if (!wanted(b)) {
+    throw InputError(fmt::format("--start-bifurcation {}: that row is a {}, which --curve-types "
+                                 "leaves out",
+                                 row, orbits::bifurcation_name(b.type)));
+  }
+  return {b};
 }
 
 void add_continue_flags(CLI::App& command, ContinueFlags& flags) {
@@ -602,6 +704,23 @@ void add_continue_flags(CLI::App& command, ContinueFlags& flags) {
   command.add_option("--threads", flags.threads,
                      "OpenMP threads of --over-sweep (default: all cores)")
       ->check(non_negative_number());
+  command.add_option("--curves", flags.curves,
+                     "Q=FROM:TO: after the branch, follow each fold, period doubling,\n"
+                     "Neimark-Sacker point and grazing it located in the plane of --parameter\n"
+                     "and Q over FROM:TO (any parameter --parameter takes), with their\n"
+                     "codimension-two points: OUT/curves.csv, OUT/codim2.csv,\n"
+                     "OUT/bifurcation_curves.png");
+  command.add_option("--curve-types", flags.curve_types,
+                     "The curves to follow: fold, period-doubling, neimark-sacker, grazing,\n"
+                     "comma separated (default: all four)")
+      ->delimiter(',');
+  command.add_option("--start-bifurcation", flags.start_bifurcation,
+                     "Follow only the curve of this row of bifurcations.csv (1 for the first;\n"
+                     "0: every located row of the --curve-types)")
+      ->check(non_negative_number());
+  command.add_option("--curve-points", flags.curve_points,
+                     "Points of each curve in each direction from the branch, at most")
+      ->check(positive_number());
 }
 
 void add_continue_command(CLI::App& app) {

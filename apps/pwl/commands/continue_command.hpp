@@ -5,10 +5,12 @@
 // branch_section.csv and bifurcations.csv as the branch grows, and draws its figures; the Python
 // module runs the same continuation and keeps the points in memory.
 #include <CLI/CLI.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "commands/orbit_options.hpp"
+#include "pwl/orbits/bifurcation_curves.hpp"
 #include "pwl/orbits/continuation.hpp"
 #include "pwl/study/point_model.hpp"
 
@@ -31,6 +33,12 @@ struct ContinueFlags {
   int over_periods = 100;
   bool no_plot = false;
   int threads = 0;
+  // Bifurcation curves in two parameters (bifurcation_curves.hpp): Q=FROM:TO, the types, one row
+  // of bifurcations.csv to start from (0: every row of those types), points per direction.
+  std::string curves;
+  std::vector<std::string> curve_types;
+  int start_bifurcation = 0;
+  int curve_points = 1000;
 };
 
 // Every flag of pwl continue (add_orbit_flags without --dt, --parameter, --range, ...), with
@@ -47,7 +55,18 @@ struct ContinuationProblem {
   analysis::PointCase first_case;      // the case at FROM, where the guess is taken
   OrbitMethod method;
   orbits::ContinuationOptions options;
+  // With --curves: the curves' options (P the branch's parameter and range), and the row of
+  // bifurcations.csv they start from (0: every located row of their types).
+  std::optional<orbits::CurvesOptions> curves;
+  int start_bifurcation = 0;
 };
+
+// The bifurcations the curves start from: every located one of the curves' types, or the row
+// --start-bifurcation names (1-based, in bifurcations.csv's order). Throws InputError naming
+// --start-bifurcation when that row does not exist, was not located, or is of a type
+// --curve-types leaves out.
+std::vector<orbits::Bifurcation> curve_starts(const ContinuationProblem& problem,
+                                              const std::vector<orbits::Bifurcation>& found);
 
 // Checks the flags (InputError naming the flag and its value) and sets up the continuation. The
 // guess is starting_guess(flags.orbit, map) on the map of problem.first_case.

@@ -16,6 +16,8 @@ const std::vector<FlagRelation>& flag_relations() {
       {"continue", "--min-step", "--max-step", K::at_most, true, ""},
       {"continue", "--min-step", "--step", K::at_most, true,
        "the branch would stop at its first step"},
+      {"continue", "--curves", "--parameter", K::differs, false,
+       "a curve lies in the plane of two parameters"},
       {"map", "--y", "--x", K::differs, false, "both axes would vary one parameter"},
       {"basin", "--y", "--x", K::differs, false, "both axes would vary one state component"},
       {"basin", "--kept-points", "--periods", K::at_most, false,

@@ -25,6 +25,23 @@ void CsvWriter::row(const std::vector<double>& values) {
   fmt::print(file_, "{:.17g}\n", fmt::join(values, ","));
 }
 
+FlushedCsv::FlushedCsv(const std::string& path, const std::vector<std::string>& columns)
+    : file_(std::fopen(path.c_str(), "w")), path_(path) {
+  if (file_ == nullptr) throw Error(fmt::format("cannot write {}", path));
+  fmt::print(file_, "{}\n", fmt::join(columns, ","));
+  if (std::fflush(file_) != 0) throw Error(fmt::format("cannot write {}", path_));
+}
+
+FlushedCsv::~FlushedCsv() {
+  if (file_ != nullptr) std::fclose(file_);
+}
+
+void FlushedCsv::row(const std::string& text) {
+  fmt::print(file_, "{}\n", text);
+  if (std::fflush(file_) != 0) throw Error(fmt::format("cannot write {}", path_));
+  ++rows_;
+}
+
 std::string full_precision(double value) { return fmt::format("{:.17g}", value); }
 
 std::vector<std::string> state_columns(const std::string& first, Index n) {

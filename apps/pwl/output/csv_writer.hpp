@@ -26,6 +26,24 @@ class CsvWriter {
   std::string path_;
 };
 
+// A CSV file written a row of text at a time and flushed after each, so that a run that is
+// interrupted keeps every row it wrote, whole. Throws pwl::Error naming the file when it cannot
+// open or write it.
+class FlushedCsv {
+ public:
+  FlushedCsv(const std::string& path, const std::vector<std::string>& columns);
+  ~FlushedCsv();
+  FlushedCsv(const FlushedCsv&) = delete;
+  FlushedCsv& operator=(const FlushedCsv&) = delete;
+  void row(const std::string& text);
+  long rows() const { return rows_; }
+
+ private:
+  std::FILE* file_;
+  std::string path_;
+  long rows_ = 0;
+};
+
 // `value` with 17 significant digits: read back, the same double.
 std::string full_precision(double value);
 

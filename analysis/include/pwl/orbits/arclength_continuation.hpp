@@ -24,6 +24,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "pwl/types.hpp"
 
@@ -101,6 +102,10 @@ struct StepControl {
   // moves fast is not crawled along.
   double max = 0.0;
   bool chord = false;
+  // A walk that accepts this many steps in a row no longer than 16 times the minimum is stalled
+  // (a curve that is not smooth there, which the corrector crosses only at the smallest steps, if
+  // at all): it ends. 0: never.
+  int stall_steps = 0;
 
   // The predictor's error (∞-norm, relative to the state's scale) below which the chord
   // corrector's step grows by 1.5 and above which it shrinks by 0.6. On the 100-mass chain of
@@ -133,12 +138,79 @@ struct CurvePoint {
   int iterations = 0;
 };
 
+// A zero of a test function between two points of a curve, found by the Illinois variant of
+// regula falsi on the arclength: the point nearest it, its value, and the final bracket's two
+// points in the order of the arclength.
+template <class P>
+struct ArclengthZero {
+  P best;
+  double value = 0.0;
+  bool located = false;  // the ends' values had opposite signs and every trial point was found
+  P before, after;
+};
+
+// Locates the zero of a test function between a (arclength 0, value fa) and b (arclength h, value
+// fb). `trial(s, end_a, sa, end_b, sb)` returns the curve's point at arclength s (corrected onto
+// the curve, predicted by interpolating the bracket's ends) with its test value, or empty where it
+// fails; `small(end_a, sa, end_b, sb)` says when the bracket is small enough. At most 80 trials,
+// and none once the bracket is below 1e-13 of h.
+template <class P, class Trial, class Small>
+ArclengthZero<P> zero_on_arclength(const P& a, double fa, const P& b, double fb, double h,
+                                   Trial trial, Small small) {
+  const auto fabs_less = [](double x, double y) {
+    if (!std::isfinite(y)) return true;
+    if (!std::isfinite(x)) return false;
+    return std::abs(x) < std::abs(y);
+  };
+  ArclengthZero<P> out;
+  out.best = fabs_less(fa, fb) ? a : b;
+  out.value = fabs_less(fa, fb) ? fa : fb;
+  P end_a = a, end_b = b;  // the bracket's ends, at sa and sb
+  double sa = 0, sb = h;
+  out.located = std::isfinite(fa) && std::isfinite(fb) && fa * fb <= 0;
+  int side = 0;  // Illinois: which end was kept last
+  for (int it = 0; out.located && it < 80; ++it) {
+    if (small(end_a, sa, end_b, sb)) break;
+    if (std::abs(sb - sa) <= 1e-13 * std::abs(h)) break;
+    double s = sb - fb * (sb - sa) / (fb - fa);
+    if (!(s > std::min(sa, sb) && s < std::max(sa, sb))) s = 0.5 * (sa + sb);
+    std::optional<std::pair<P, double>> found = trial(s, end_a, sa, end_b, sb);
+    if (!found || !std::isfinite(found->second)) {
+      out.located = false;
+      break;
+    }
+    const double f = found->second;
+    if (std::abs(f) < std::abs(out.value)) {
+      out.best = found->first;
+      out.value = f;
+    }
+    if (f * fb < 0) {
+      sa = sb, fa = fb;
+      end_a = std::move(end_b);
+      side = 0;
+    } else {
+      if (side == 1) fa /= 2;  // Illinois
+      side = 1;
+    }
+    sb = s, fb = f;
+    end_b = std::move(found->first);
+    if (f == 0) break;
+  }
+  if (sa <= sb) {
+    out.before = std::move(end_a), out.after = std::move(end_b);
+  } else {
+    out.before = std::move(end_b), out.after = std::move(end_a);
+  }
+  return out;
+}
+
 // Why a walk along a curve ended.
 struct WalkEnd {
   enum class Kind {
     max_points,  // it accepted its largest number of points
     min_step,    // the step fell below its minimum: no solution found ahead
     turns_back,  // the curve turns back on itself even at the smallest step
+    stalled,     // StepControl::stall_steps steps in a row at the smallest steps
     problem,     // the problem stopped it (`why` says why)
   };
   Kind kind = Kind::problem;
@@ -180,6 +252,7 @@ class CurveWalk {
     P current = std::move(first);
     double h = steps.initial;
     int points = 1;
+    int crawling = 0;  // accepted steps in a row at the smallest steps
     Vector previous_secant;
     const auto end = [&](WalkEnd::Kind kind, std::string why) {
       if (last != nullptr) *last = current;
@@ -223,6 +296,10 @@ class CurveWalk {
       }
       current = std::move(*next);
       if (auto why = stop_after(current, points)) return end(WalkEnd::Kind::problem, *why);
+      crawling = h <= 16 * steps.min ? crawling + 1 : 0;
+      if (steps.stall_steps > 0 && crawling >= steps.stall_steps) {
+        return end(WalkEnd::Kind::stalled, "");
+      }
       h = steps.next(h, predictor_error, iterations, parameter_share(current.tangent));
     }
   }

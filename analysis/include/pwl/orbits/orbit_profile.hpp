@@ -19,11 +19,23 @@ struct OrbitProfile {
   Vector amplitude;     // max |x_i(t)|
   Vector max_gap;       // per gap spring: max over the orbit of g_j (> 0: it touches)
   Vector min_gap;       // min over the orbit of g_j (> 0: it never lets go)
+  Vector max_gap_time;  // where each extreme lies: t in [0, kT] from the orbit's start
+  Vector min_gap_time;
 };
 
 // The profile of the orbit through `state` over `periods` forcing periods from t = 0.
 // samples_per_period applies to methods off a fixed grid (>= 8).
 OrbitProfile orbit_profile(StroboscopicMap& map, const Vector& state, int periods,
                            int samples_per_period = 256);
+
+// One extreme of one gap function along the orbit (the largest when `largest`, else the
+// smallest), found as orbit_profile finds it, and its time t in [0, kT]: where only one is wanted
+// (a grazing curve's condition), without the others' refinements.
+struct GapExtreme {
+  double value = 0.0;
+  double time = 0.0;
+};
+GapExtreme gap_extreme(StroboscopicMap& map, const Vector& state, int periods, int spring,
+                       bool largest, int samples_per_period = 256);
 
 }  // namespace pwl::orbits

@@ -131,6 +131,11 @@ class PointModel {
   // period (θ > 0, a stiffness >= 0, a frequency that keeps the loads commensurate, ...).
   bool accepts(const SweepParameter& parameter, double value, std::string* why) const;
 
+  // The value the model gives `parameter`, from which with() would set it: θ, ζ, and α or Δ̃ of
+  // the chain when every mass has the same, 1 for the load scale (amplitude) and the damping
+  // scale, a spring's stiffness or gap, a load's amplitude or frequency. Throws InputError where
+  // there is no single value (masses with different α) or the model lacks the parameter.
+  double value(const SweepParameter& parameter) const;
   // A copy with the parameter set to `value` (no check beyond has(); see accepts()).
   PointModel with(const SweepParameter& parameter, double value) const;
   // The structure and period to integrate. Throws InputError for an invalid model.

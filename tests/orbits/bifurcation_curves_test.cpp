@@ -1,0 +1,280 @@
+// Bifurcation curves in two parameters against independent truth:
+//  - grazing curves of a contact-free branch in closed form: where no spring touches, the chain is
+//    linear and its period-1 response is H(θ) Q e^{iθt}, H = (K − θ²M + iθC)⁻¹ (K = L, C = ζL,
+//    M = I), so spring s grazes where |(HQ)_s| = Δ̃: the curves in (θ, Δ̃) follow that to 1e-9, and
+//    the double grazing lies where two springs' amplitudes are equal, the same point from both
+//    curves;
+//  - period-doubling and Neimark–Sacker curves of figure 5's chain in (θ, α), and the fold curve of
+//    the hardening gap oscillator in (θ, load amplitude): at five values of the second parameter the
+//    curve's θ agrees to 1e-8 with the point a separate one-parameter continuation in θ locates;
+//  - that fold curve holds both folds of the oscillator's hysteresis, which meet in a cusp: above the
+//    cusp's amplitude a one-parameter continuation finds two folds, below it none.
+#include <catch2/catch.hpp>
+#include <Eigen/LU>
+#include <cmath>
+#include <complex>
+#include <functional>
+
+#include "orbit_cases.hpp"
+#include "pwl/model/chain_builders.hpp"
+#include "pwl/orbits/bifurcation_curves.hpp"
+
+using namespace pwl;
+using namespace pwl::orbits;
+using pwl::test::measured;
+
+namespace {
+
+using analysis::SweepParameter;
+
+// The branch in θ from `from` to `to` of the chain `base`, started from its motion after 200
+// periods.
+ContinuationResult branch(const NondimensionalChain& base, double from, double to,
+                          int max_points = 2000) {
+  NondimensionalChain start = base;
+  start.theta = from;
+  StroboscopicMap map(analysis::PointCase(start), MethodSettings{Method::exact}, 1);
+  const Vector guess =
+      pwl::test::poincare_points(map, Vector::Zero(2 * base.masses), 200, 1).back();
+  ContinuationOptions o;
+  o.parameter = SweepParameter::theta;
+  o.start = from;
+  o.end = to;
+  o.max_points = max_points;
+  return continue_periodic_orbit(analysis::PointModel(start), guess, o);
+}
+
+CurvesOptions curves_options(double p_from, double p_to, const SweepParameter& second,
+                             double q_from, double q_to, std::vector<CurveType> types) {
+  CurvesOptions c;
+  c.first = SweepParameter::theta;
+  c.second = second;
+  c.p_from = p_from;
+  c.p_to = p_to;
+  c.q_from = q_from;
+  c.q_to = q_to;
+  c.types = std::move(types);
+  return c;
+}
+
+// The bifurcations of `type` on a one-parameter branch in θ of `chain` between from and to.
+std::vector<double> located(const NondimensionalChain& chain, double from, double to,
+                            BifurcationType type) {
+  std::vector<double> found;
+  for (const Bifurcation& b : branch(chain, from, to).bifurcations) {
+    if (b.type == type && b.located && b.branch == 0) found.push_back(b.parameter);
+  }
+  return found;
+}
+
+// The closed-form amplitudes |(H(θ) Q)_j| of the nondimensional chain without contact.
+Vector linear_amplitudes(const NondimensionalChain& c, double theta) {
+  const GapStructure s = make_chain(c);
+  const Eigen::MatrixXcd K = Matrix(s.stiffness).cast<std::complex<double>>();
+  const Eigen::MatrixXcd C = Matrix(s.damping).cast<std::complex<double>>();
+  const Eigen::MatrixXcd M = Matrix(s.mass).cast<std::complex<double>>();
+  const std::complex<double> i(0.0, 1.0);
+  Eigen::VectorXcd Q(c.masses);
+  for (int j = 0; j < c.masses; ++j) Q(j) = c.amplitude[static_cast<std::size_t>(j)];
+  const Eigen::VectorXcd x = (K - theta * theta * M + i * theta * C).partialPivLu().solve(Q);
+  return x.cwiseAbs();
+}
+
+// Every curve point of `curve` as (P, Q, row).
+std::vector<const CurvePointRecord*> rows_of(const CurvesResult& r, int curve) {
+  std::vector<const CurvePointRecord*> rows;
+  for (const CurvePointRecord& p : r.points) {
+    if (p.curve == curve) rows.push_back(&p);
+  }
+  return rows;
+}
+
+}  // namespace
+
+TEST_CASE("grazing curves of a contact-free branch follow the closed form, and meet in a double "
+          "grazing where two amplitudes are equal",
+          "[orbits][curves]") {
+  // Figure 4a's chain with gaps of 1: from θ = 0.8 down, spring 2 lets go at θ = 0.6817 and the
+  // orbit is linear until spring 4 touches at θ = 0.6170.
+  NondimensionalChain chain = paper_five_dof_case("4a");
+  chain.gap = {1.0};
+  const ContinuationResult b = branch(chain, 0.8, 0.6);
+  std::vector<Bifurcation> grazings;
+  for (const Bifurcation& g : b.bifurcations) {
+    if (g.type == BifurcationType::grazing && g.located) grazings.push_back(g);
+  }
+  REQUIRE(grazings.size() == 2);
+  CHECK(grazings[0].spring == 1);
+  CHECK(grazings[1].spring == 3);
+  const CurvesOptions o =
+      curves_options(0.8, 0.6, SweepParameter::gap, 0.9, 1.1, {CurveType::grazing});
+  const CurvesResult r = follow_bifurcation_curves(analysis::PointModel(chain), grazings, o);
+  REQUIRE(r.curves.size() == 2);
+  // Every point of the curves where the closed form says the orbit is contact-free lies on
+  // Δ̃ = |(H Q)_s|.
+  double worst = 0.0;
+  int checked = 0;
+  for (const CurvePointRecord& p : r.points) {
+    const Vector a = linear_amplitudes(chain, p.p);
+    bool free = true;
+    for (Index j = 0; j < a.size(); ++j) {
+      if (j != p.spring && a(j) >= p.q * (1 - 1e-9)) free = false;
+    }
+    if (!free) continue;
+    worst = std::max(worst, std::abs(a(p.spring) - p.q));
+    ++checked;
+  }
+  measured("grazing curves: |gap - |HQ|_s| over contact-free points", worst);
+  CHECK(checked >= 40);
+  CHECK(worst <= 1e-9);
+
+  // The double grazing: |HQ|_2 = |HQ|_4, by bisection on θ.
+  double lo = 0.62, hi = 0.635;
+  const auto difference = [&](double theta) {
+    const Vector a = linear_amplitudes(chain, theta);
+    return a(1) - a(3);
+  };
+  REQUIRE(difference(lo) * difference(hi) < 0);
+  while (hi - lo > 1e-14) {
+    const double mid = 0.5 * (lo + hi);
+    (difference(mid) * difference(lo) > 0 ? lo : hi) = mid;
+  }
+  const double theta_star = 0.5 * (lo + hi);
+  const double gap_star = linear_amplitudes(chain, theta_star)(1);
+  const Codim2Point* dg = nullptr;
+  for (const Codim2Point& c : r.codim2) {
+    if (c.type == "double-grazing") dg = &c;
+  }
+  REQUIRE(dg != nullptr);
+  INFO("double grazing at theta = " << dg->p << ", gap = " << dg->q);
+  measured("double grazing: theta - closed form", dg->p - theta_star);
+  measured("double grazing: gap - closed form", dg->q - gap_star);
+  CHECK(std::abs(dg->p - theta_star) <= 1e-8);
+  CHECK(std::abs(dg->q - gap_star) <= 1e-8);
+  // Found on both curves: and each curve alone lands on the same point.
+  CHECK(dg->curves.size() == 2);
+  std::vector<Codim2Point> alone;
+  for (const Bifurcation& g : grazings) {
+    const CurvesResult one = follow_bifurcation_curves(analysis::PointModel(chain), {g}, o);
+    for (const Codim2Point& c : one.codim2) {
+      if (c.type == "double-grazing") alone.push_back(c);
+    }
+  }
+  REQUIRE(alone.size() == 2);
+  measured("double grazing from the two curves: |dtheta|", std::abs(alone[0].p - alone[1].p));
+  CHECK(std::abs(alone[0].p - alone[1].p) <= 1e-8);
+  CHECK(std::abs(alone[0].q - alone[1].q) <= 1e-8);
+}
+
+TEST_CASE("period-doubling and Neimark-Sacker curves agree with one-parameter continuations at "
+          "five values of the second parameter",
+          "[orbits][curves]") {
+  const NondimensionalChain chain = paper_five_dof_case("5");  // α = 5
+  struct Case {
+    double from, to;
+    BifurcationType type;
+  };
+  for (const Case& k : {Case{0.99, 1.03, BifurcationType::period_doubling},
+                        Case{2.59, 2.62, BifurcationType::neimark_sacker}}) {
+    INFO(bifurcation_name(k.type));
+    std::vector<Bifurcation> starts;
+    for (const Bifurcation& b : branch(chain, k.from, k.to).bifurcations) {
+      if (b.type == k.type && b.located) starts.push_back(b);
+    }
+    REQUIRE(starts.size() == 1);
+    const CurvesOptions o = curves_options(k.from - 0.05, k.to + 0.05, SweepParameter::alpha, 4.5,
+                                           5.5, {curve_type_of(k.type)});
+    const CurvesResult r = follow_bifurcation_curves(analysis::PointModel(chain), starts, o);
+    REQUIRE(r.curves.size() == 1);
+    const auto rows = rows_of(r, 0);
+    REQUIRE(rows.size() >= 10);
+    int compared = 0;
+    for (std::size_t i = 1; i < rows.size() && compared < 5; i += rows.size() / 6) {
+      const CurvePointRecord& p = *rows[i];
+      NondimensionalChain at = chain;
+      at.alpha = {p.q};
+      const std::vector<double> found = located(at, p.p - 0.004, p.p + 0.004, k.type);
+      REQUIRE(found.size() == 1);
+      INFO("alpha = " << p.q << ": curve theta " << p.p << ", one-parameter " << found[0]);
+      measured("curve theta - one-parameter continuation", p.p - found[0]);
+      CHECK(std::abs(p.p - found[0]) <= 1e-8);
+      ++compared;
+    }
+    CHECK(compared == 5);
+  }
+}
+
+TEST_CASE("the hardening oscillator's two folds are one curve in (theta, amplitude), meeting in "
+          "a cusp",
+          "[orbits][curves]") {
+  // One mass, α = 3, ζ = 0.1, Δ̃ = 1.5, Q = 0.5: the resonance bends toward higher θ once the mass
+  // reaches its gap, with two folds and hysteresis between them.
+  const NondimensionalChain chain = pwl::test::hardening_oscillator(1.0);
+  std::vector<Bifurcation> folds;
+  for (const Bifurcation& b : branch(chain, 0.8, 2.0).bifurcations) {
+    if (b.type == BifurcationType::fold && b.located) folds.push_back(b);
+  }
+  REQUIRE(folds.size() == 2);
+  const CurvesOptions o =
+      curves_options(0.8, 2.0, SweepParameter::amplitude, 0.2, 2.0, {CurveType::fold});
+  const CurvesResult r = follow_bifurcation_curves(analysis::PointModel(chain), folds, o);
+  // The second fold lies on the first one's curve.
+  REQUIRE(r.curves.size() == 1);
+  const auto rows = rows_of(r, 0);
+  // At five amplitudes of the curve, both folds of a one-parameter continuation; the curve's θ is
+  // one of them.
+  int compared = 0;
+  for (std::size_t i = 2; i < rows.size() && compared < 5; i += rows.size() / 6) {
+    const CurvePointRecord& p = *rows[i];
+    NondimensionalChain at = chain;
+    for (double& q : at.amplitude) q *= p.q;
+    const std::vector<double> found = located(at, 0.8, 2.0, BifurcationType::fold);
+    REQUIRE(!found.empty());
+    double nearest = found[0];
+    for (double f : found) {
+      if (std::abs(f - p.p) < std::abs(nearest - p.p)) nearest = f;
+    }
+    INFO("amplitude scale " << p.q << ": curve theta " << p.p << ", nearest fold " << nearest);
+    measured("fold curve theta - one-parameter fold", p.p - nearest);
+    CHECK(std::abs(p.p - nearest) <= 1e-8);
+    ++compared;
+  }
+  CHECK(compared == 5);
+  // The cusp: located on the curve, with two folds just above its amplitude and none below, and
+  // the two folds closing in on it as the amplitude comes down to it (like the 3/2 power of the
+  // distance: 8 times closer at a quarter of the distance; at least 3 asked).
+  const Codim2Point* cusp = nullptr;
+  for (const Codim2Point& c : r.codim2) {
+    if (c.type == "cusp") cusp = &c;
+  }
+  REQUIRE(cusp != nullptr);
+  INFO("cusp at theta = " << cusp->p << ", amplitude scale " << cusp->q);
+  const auto folds_at = [&](double factor) {
+    NondimensionalChain at = chain;
+    for (double& q : at.amplitude) q *= cusp->q * factor;
+    return located(at, 0.8, 2.0, BifurcationType::fold);
+  };
+  CHECK(folds_at(0.99).empty());
+  const std::vector<double> near = folds_at(1.01), far = folds_at(1.04);
+  REQUIRE(near.size() == 2);
+  REQUIRE(far.size() == 2);
+  const double near_width = std::abs(near[0] - near[1]), far_width = std::abs(far[0] - far[1]);
+  measured("cusp: folds' separation at 1.01 and 1.04 of its amplitude", near_width / far_width);
+  CHECK(near_width < far_width / 3);
+  CHECK(std::abs(near[0] - cusp->p) < 0.01);
+  CHECK(std::abs(near[1] - cusp->p) < 0.01);
+}
+
+TEST_CASE("curves refuse a second parameter equal to the first and a range without the branch",
+          "[orbits][curves]") {
+  const NondimensionalChain chain = paper_five_dof_case("5");
+  CurvesOptions o = curves_options(0.5, 3, SweepParameter::theta, 1, 2, {CurveType::fold});
+  CHECK_THROWS_WITH(follow_bifurcation_curves(analysis::PointModel(chain), {}, o),
+                    Catch::Contains("the second parameter theta is the first"));
+  o = curves_options(0.5, 3, SweepParameter::alpha, 6, 8, {CurveType::fold});
+  CHECK_THROWS_WITH(follow_bifurcation_curves(analysis::PointModel(chain), {}, o),
+                    Catch::Contains("the branch's alpha = 5 lies outside the alpha range 6:8"));
+  o = curves_options(0.5, 3, SweepParameter::zeta, -1, 1, {CurveType::fold});
+  CHECK_THROWS_WITH(follow_bifurcation_curves(analysis::PointModel(chain), {}, o),
+                    Catch::Contains("zeta range -1:1: at zeta = -1"));
+}
