@@ -17,6 +17,7 @@
 #include "pwl/integrators/accuracy_step.hpp"
 #include "bench/accuracy_bench.hpp"
 #include "bench/bench_chain.hpp"
+#include "bench/bench_curves.hpp"
 #include "bench/bench_orbits.hpp"
 #include "bench/bench_scaling.hpp"
 #include "bench/bench_soak.hpp"
@@ -165,6 +166,7 @@ void add_bench_command(CLI::App& app) {
   add_accuracy_benches(*bench);
   add_sweep_bench(*bench);
   add_orbits_bench(*bench);
+  add_curves_bench(*bench);
   add_soak_bench(*bench);
 }
 

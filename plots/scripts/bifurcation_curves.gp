@@ -1,7 +1,8 @@
 # Bifurcation curves in two parameters (pwl continue --curves): every curve in the plane (P, Q),
 # each type in its own style, and the codimension-two points marked and named (curve_lines.gp).
 # Variables (gnuplot -e): curves (curves.csv: curve,type,P,Q,...), codim2 (codim2.csv:
-# type,P,Q,curves,detail), ncodim2 (its rows), out, fmt, xname, yname, title.
+# type,P,Q,curves,detail), ncodim2 (its rows), out, fmt, xname, yname, title, and optionally
+# xlo, xhi, ylo, yhi (the rectangle the curves were followed in: the figure's frame).
 if (!exists("curves")) curves = 'continuation/curves.csv'
 if (!exists("codim2")) codim2 = 'continuation/codim2.csv'
 if (!exists("out")) out = 'continuation/bifurcation_curves.png'
@@ -18,4 +19,6 @@ set xlabel xname
 set ylabel yname
 set key outside right top
 set grid
+if (exists("xlo") && exists("xhi")) { set xrange [xlo:xhi] }
+if (exists("ylo") && exists("yhi")) { set yrange [ylo:yhi] }
 plot NaN notitle @curvelines

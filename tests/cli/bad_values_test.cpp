@@ -248,6 +248,7 @@ const std::map<std::string, std::vector<std::string>>& base_arguments() {
       {"bench sweep", {"--quiet", "--out", "D"}},
       {"bench orbits", {"--quick", "--quiet", "--out", "D"}},
       {"bench soak", {"--quiet", "--out", "D"}},
+      {"bench curves", {"--quick", "--out", "D"}},
   };
   return base;
 }

@@ -33,3 +33,11 @@ add_test(NAME cli_sweep_stop_signals
                  ${PWL_CLI_OUT}/stop_signals ${PWL_STOP_SIGNALS_TRANSIENT})
 set_tests_properties(cli_sweep_stop_signals PROPERTIES SKIP_RETURN_CODE 77 TIMEOUT 600
                      PASS_REGULAR_EXPRESSION "stopped by SIGINT and SIGTERM, resumed, identical")
+# The same stop in the middle of pwl continue --curves (release only: the curves take a while
+# under the sanitizers before there are rows to stop between).
+add_test(NAME cli_curves_stop_signals
+         COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/stop_curves.sh $<TARGET_FILE:pwl>
+                 ${PWL_CLI_OUT}/stop_curves)
+set_tests_properties(cli_curves_stop_signals PROPERTIES SKIP_RETURN_CODE 77 TIMEOUT 300
+                     PASS_REGULAR_EXPRESSION "stopped by SIGINT and SIGTERM, every row whole"
+                     LABELS release-only)

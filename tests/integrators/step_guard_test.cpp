@@ -292,6 +292,10 @@ TEST_CASE("the step guard accepts the paper's settings and every shipped scene's
   scenes["bench_sweep"] = theta_range(0);
   scenes["five_dof_continuation"] = theta_range(0);  // exact by default; the PIM if asked
   scenes["five_dof_orbit"] = {chain_at("4a", 0, 0)};
+  // The curves follow their orbits with the exact solver; the PIM if asked, over the (θ, α)
+  // rectangle of the map.
+  scenes["theta_alpha_curves"] = theta_range(1.0);
+  for (Case& c : theta_range(15.0)) scenes["theta_alpha_curves"].push_back(std::move(c));
   scenes["theta_alpha_map"] = theta_range(1.0);
   for (Case& c : theta_range(15.0)) scenes["theta_alpha_map"].push_back(std::move(c));
   {
@@ -306,9 +310,9 @@ TEST_CASE("the step guard accepts the paper's settings and every shipped scene's
   scenes["bench_chain"] = {paper_chain};
   // Benchmarks that choose their steps themselves: bench stability sweeps them into the refused
   // region on purpose (it measures the failures the limits come from), bench accuracy and
-  // bench scaling over their own grids, bench orbits with the exact solver.
+  // bench scaling over their own grids, bench orbits and bench curves with the exact solver.
   const std::set<std::string> unguarded{"bench_stability", "bench_accuracy", "bench_scaling",
-                                        "bench_orbits"};
+                                        "bench_orbits", "bench_curves"};
 
   const std::filesystem::path dir =
       std::filesystem::path(__FILE__).parent_path().parent_path().parent_path() / "apps" /

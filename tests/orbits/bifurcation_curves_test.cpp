@@ -8,7 +8,10 @@
 //    the hardening gap oscillator in (θ, load amplitude): at five values of the second parameter the
 //    curve's θ agrees to 1e-8 with the point a separate one-parameter continuation in θ locates;
 //  - that fold curve holds both folds of the oscillator's hysteresis, which meet in a cusp: above the
-//    cusp's amplitude a one-parameter continuation finds two folds, below it none.
+//    cusp's amplitude a one-parameter continuation finds two folds, below it none;
+//  - strong resonances on Neimark–Sacker curves: a 1:4 point where a continuation in θ at its α
+//    locates the Neimark–Sacker point at the same θ with its multiplier at ±i, and a 1:2 point
+//    whose orbit has two multipliers at −1, neither also reported as a flip– or fold–NS point.
 #include <catch2/catch.hpp>
 #include <Eigen/LU>
 #include <cmath>
@@ -18,6 +21,7 @@
 #include "orbit_cases.hpp"
 #include "pwl/model/chain_builders.hpp"
 #include "pwl/orbits/bifurcation_curves.hpp"
+#include "pwl/orbits/periodic_orbit.hpp"
 
 using namespace pwl;
 using namespace pwl::orbits;
@@ -277,4 +281,72 @@ TEST_CASE("curves refuse a second parameter equal to the first and a range witho
   o = curves_options(0.5, 3, SweepParameter::zeta, -1, 1, {CurveType::fold});
   CHECK_THROWS_WITH(follow_bifurcation_curves(analysis::PointModel(chain), {}, o),
                     Catch::Contains("zeta range -1:1: at zeta = -1"));
+}
+
+TEST_CASE("strong resonances on a Neimark-Sacker curve sit where a one-parameter continuation's "
+          "Neimark-Sacker multiplier has the resonant angle, and are not also fold- or flip-NS "
+          "points",
+          "[orbits][curves]") {
+  // Figure 5's chain: the Neimark–Sacker point at θ = 1.9117719883 (α = 5), followed up in α,
+  // passes a 1:4 resonance near (θ, α) = (2.0017, 8.48); the one at θ = 0.9920298549, followed
+  // down, ends in a 1:2 resonance near (0.9751, 2.9496), where the pair reaches −1 and det(M + I)
+  // vanishes with it.
+  const NondimensionalChain chain = paper_five_dof_case("5");
+  struct Case {
+    double from, to, q_from, q_to;
+    const char* resonance;
+    double kappa;
+  };
+  for (const Case& k : {Case{1.90, 1.92, 4.5, 9.0, "resonance-1:4", 0.0},
+                        Case{0.985, 1.0, 2.5, 5.5, "resonance-1:2", -1.0}}) {
+    INFO(k.resonance);
+    std::vector<Bifurcation> starts;
+    for (const Bifurcation& b : branch(chain, k.from, k.to).bifurcations) {
+      if (b.type == BifurcationType::neimark_sacker && b.located) starts.push_back(b);
+    }
+    REQUIRE(starts.size() == 1);
+    CurvesOptions o = curves_options(0.9, 2.2, SweepParameter::alpha, k.q_from, k.q_to,
+                                     {CurveType::neimark_sacker});
+    const CurvesResult r = follow_bifurcation_curves(analysis::PointModel(chain), starts, o);
+    const Codim2Point* point = nullptr;
+    for (const Codim2Point& c : r.codim2) {
+      if (c.type == k.resonance) point = &c;
+    }
+    REQUIRE(point != nullptr);
+    for (const Codim2Point& c : r.codim2) {
+      const bool same = std::abs(c.p - point->p) < 1e-6 && std::abs(c.q - point->q) < 1e-6;
+      CHECK_FALSE((same && c.type == "period-doubling-neimark-sacker"));
+      CHECK_FALSE((same && c.type == "fold-neimark-sacker"));
+    }
+    if (k.kappa == 0.0) {
+      // At the resonance's α, a continuation in θ locates the Neimark–Sacker point at the same θ
+      // with its multiplier at e^{iπ/2}.
+      NondimensionalChain at = chain;
+      at.alpha = {point->q};
+      std::vector<Bifurcation> ns;
+      for (const Bifurcation& b : branch(at, point->p - 0.004, point->p + 0.004).bifurcations) {
+        if (b.type == BifurcationType::neimark_sacker && b.located) ns.push_back(b);
+      }
+      REQUIRE(ns.size() == 1);
+      measured("1:4 resonance theta - one-parameter NS", point->p - ns[0].parameter);
+      CHECK(std::abs(point->p - ns[0].parameter) <= 1e-7);
+      CHECK(std::abs(std::abs(ns[0].multiplier) - 1.0) <= 1e-7);
+      CHECK(std::abs(ns[0].multiplier.real() / std::abs(ns[0].multiplier) - k.kappa) <= 1e-6);
+    } else {
+      // At a 1:2 resonance two multipliers sit at −1: the orbit there (a shooting Newton from the
+      // curve's state) has two within 1e-3 of it (a double eigenvalue splits like the square root
+      // of the location's error).
+      NondimensionalChain at = chain;
+      at.alpha = {point->q};
+      at.theta = point->p;
+      StroboscopicMap map(analysis::PointCase(at), MethodSettings{Method::exact}, 1);
+      const PeriodicOrbit orbit = find_periodic_orbit(map, point->state, ShootingOptions{});
+      REQUIRE(orbit.residual <= 1e-9);
+      int near = 0;
+      for (const std::complex<double>& mu : orbit.multipliers.values) {
+        if (std::abs(mu + 1.0) <= 1e-3) ++near;
+      }
+      CHECK(near == 2);
+    }
+  }
 }

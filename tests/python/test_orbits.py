@@ -57,6 +57,27 @@ def test_continuation_equals_the_cli_files(cli):
     assert pwl.continuation is pwl.continue_
 
 
+def test_curves_equal_the_cli_files(cli):
+    # Figure 5's period doubling at theta = 1.0098 followed in (theta, alpha).
+    c = pwl.continue_(figure="5", parameter="theta", range=(1.0, 1.02), curves=("alpha", (4.5, 5.5)),
+                      curve_types=["period-doubling"])
+    out = cli.out("continue", "--figure", "5", "--parameter", "theta", "--range", "1.0:1.02",
+                  "--curves", "alpha=4.5:5.5", "--curve-types", "period-doubling", "--no-plot",
+                  "--quiet")
+    rows = read_csv(out / "curves.csv")
+    count = len(rows["curve"])
+    assert count > 10 and c.curves["curve"].shape == (count,)
+    for name in ("curve", "theta", "alpha", "period", "kappa"):
+        assert largest_difference(c.curves[name], rows[name]) <= 1e-12, name
+    assert list(c.curves["type"]) == ["period-doubling"] * count
+    assert largest_difference(c.curves["multiplier"].real, rows["multiplier_re"]) <= 1e-12
+    assert largest_difference(c.curves["state"], state_matrix(rows, STATE)) <= 1e-12
+    found = read_csv(out / "codim2.csv")
+    assert len(c.codim2["type"]) == len(np.atleast_1d(found["type"]))
+    assert len(c.curve_ends) == 1 and all(c.curve_ends[0])
+    assert "1 curve(s)" in repr(c)
+
+
 @pytest.mark.parametrize("job, flags, args", [
     ("orbit", dict(period=0), ["--period", "0"]),
     ("orbit", dict(shots=3, period=2), ["--shots", "3", "--period", "2"]),
@@ -64,6 +85,10 @@ def test_continuation_equals_the_cli_files(cli):
     ("continue", dict(parameter="theta", range="1:1"), ["--parameter", "theta", "--range", "1:1"]),
     ("continue", dict(parameter="alpha", range="-1:2"),
      ["--parameter", "alpha", "--range", "-1:2"]),
+    ("continue", dict(parameter="theta", range=(0.9, 1), curves=("theta", (1, 2))),
+     ["--parameter", "theta", "--range", "0.9:1", "--curves", "theta=1:2"]),
+    ("continue", dict(parameter="theta", range=(0.9, 1), curves=("alpha", (6, 8))),
+     ["--parameter", "theta", "--range", "0.9:1", "--curves", "alpha=6:8"]),
 ])
 def test_bad_values_raise_input_error_with_the_cli_message(cli, job, flags, args):
     function = pwl.continue_ if job == "continue" else pwl.orbit

@@ -157,4 +157,29 @@ std::optional<CorrectedPoint> correct_on_curve(DefiningSystem& system, const Vec
   return fall_back();
 }
 
+bool walk_settings_valid(double initial_step, double min_step, double max_step, int max_points,
+                         int max_corrections, double locate_tolerance, std::string* why) {
+  for (const auto& [name, value] : {std::pair{"initial step", initial_step},
+                                    std::pair{"min step", min_step},
+                                    std::pair{"max step", max_step}}) {
+    if (!(value >= 0) || !std::isfinite(value)) {
+      *why = fmt::format("{} = {} must be >= 0 and finite (0: the default)", name, value);
+      return false;
+    }
+  }
+  if (max_points < 2) {
+    *why = fmt::format("max points = {} must be >= 2", max_points);
+    return false;
+  }
+  if (max_corrections < 2) {
+    *why = fmt::format("max corrections = {} must be >= 2", max_corrections);
+    return false;
+  }
+  if (!(locate_tolerance > 0) || !std::isfinite(locate_tolerance)) {
+    *why = fmt::format("locate tolerance = {} must be positive and finite", locate_tolerance);
+    return false;
+  }
+  return true;
+}
+
 }  // namespace pwl::orbits

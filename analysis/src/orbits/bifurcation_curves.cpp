@@ -58,24 +58,8 @@ bool CurvesOptions::is_valid(std::string* why) const {
       return false;
     }
   }
-  for (const auto& [name, value] : {std::pair{"initial step", initial_step},
-                                    std::pair{"min step", min_step},
-                                    std::pair{"max step", max_step}}) {
-    if (!(value >= 0) || !std::isfinite(value)) {
-      *why = fmt::format("{} = {} must be >= 0 and finite (0: the default)", name, value);
-      return false;
-    }
-  }
-  if (max_points < 2) {
-    *why = fmt::format("max points = {} must be >= 2", max_points);
-    return false;
-  }
-  if (max_corrections < 2) {
-    *why = fmt::format("max corrections = {} must be >= 2", max_corrections);
-    return false;
-  }
-  if (!(locate_tolerance > 0) || !std::isfinite(locate_tolerance)) {
-    *why = fmt::format("locate tolerance = {} must be positive and finite", locate_tolerance);
+  if (!walk_settings_valid(initial_step, min_step, max_step, max_points, max_corrections,
+                           locate_tolerance, why)) {
     return false;
   }
   if (types.empty()) {
@@ -579,12 +563,65 @@ class CurvesRunner {
       return next;
     }
 
-    std::optional<std::string> stop_before(const CurvePt& /*from*/, CurvePt& to, double h,
+    std::optional<std::string> stop_before(const CurvePt& from, CurvePt& to, double h,
                                            int points) override {
       if (points > 10 && (to.u - first_.u).norm() < h) {
         closed_ = true;
         return std::string("closed on itself");
       }
+      return clip(from, to, h);
+    }
+
+    // A step that leaves the rectangle ends on its edge: `to` becomes the curve's point where it
+    // crosses the edge it crosses first (located on the arclength to 1e-10 of the range), so the
+    // curves end on the figure's frame and no codimension-two point is looked for outside it.
+    // Where that point cannot be found (the correction fails between the two, as across a
+    // grazing), the walk ends at `from`, the last point inside, and says so.
+    std::optional<std::string> clip(const CurvePt& from, CurvePt& to, double h) {
+      const double p_range = r_.p_hi_ - r_.p_lo_, q_range = r_.q_hi_ - r_.q_lo_;
+      // The four edges as inside-positive distances, scaled by their range.
+      const auto inside = [&](const CurvePt& pt, int edge) {
+        const double p = r_.system_->p(pt.u), q = r_.system_->q(pt.u);
+        switch (edge) {
+          case 0: return (r_.q_hi_ - q) / q_range;
+          case 1: return (q - r_.q_lo_) / q_range;
+          case 2: return (r_.p_hi_ - p) / p_range;
+          default: return (p - r_.p_lo_) / p_range;
+        }
+      };
+      int edge = -1;
+      double first = 2.0;  // the fraction of the step where the edge is crossed, linearly
+      for (int e = 0; e < 4; ++e) {
+        const double a = inside(from, e), b = inside(to, e);
+        if (a >= 0 && b < 0 && a / (a - b) < first) first = a / (a - b), edge = e;
+      }
+      if (edge < 0) return std::nullopt;
+      const auto trial = [&](double s, const CurvePt& end_a, double sa, const CurvePt& end_b,
+                             double sb) -> std::optional<std::pair<CurvePt, double>> {
+        const double w = (s - sa) / (sb - sa);
+        const Vector guess = (1 - w) * end_a.u + w * end_b.u;
+        std::optional<CurvePt> pt =
+            r_.corrected(guess, from.u + s * from.tangent, from.tangent, &from.jacobian,
+                         r_.options_.max_corrections + 3, 0.0);
+        if (!pt) return std::nullopt;
+        const double f = inside(*pt, edge);
+        return std::pair<CurvePt, double>{std::move(*pt), f};
+      };
+      const auto small = [&](const CurvePt& end_a, double, const CurvePt& end_b, double) {
+        return std::abs(inside(end_a, edge) - inside(end_b, edge)) <= 1e-10;
+      };
+      ArclengthZero<CurvePt> zero =
+          zero_on_arclength(from, inside(from, edge), to, inside(to, edge), h, trial, small);
+      if (!zero.located || std::abs(zero.value) > 1e-9) {
+        const analysis::SweepParameter& left = edge < 2 ? r_.options_.second : r_.options_.first;
+        return fmt::format("left the {} range after {} = {:.10g}, {} = {:.10g}, where the curve "
+                           "could not be followed to the range's edge",
+                           left.name(), r_.options_.first.name(), r_.system_->p(from.u),
+                           r_.options_.second.name(), r_.system_->q(from.u));
+      }
+      zero.best.tangent = from.tangent;
+      to = std::move(zero.best);
+      edge_ = edge;
       return std::nullopt;
     }
 
@@ -600,15 +637,14 @@ class CurvesRunner {
     std::optional<std::string> stop_after(const CurvePt& point, int /*points*/) override {
       const double p = r_.system_->p(point.u), q = r_.system_->q(point.u);
       const double pm = 1e-9 * (r_.p_hi_ - r_.p_lo_), qm = 1e-9 * (r_.q_hi_ - r_.q_lo_);
-      if (q > r_.q_hi_ + qm || q < r_.q_lo_ - qm) {
+      // Clipped onto an edge (clip) or past one: which range it left.
+      const bool q_out = q > r_.q_hi_ + qm || q < r_.q_lo_ - qm;
+      const bool p_out = p > r_.p_hi_ + pm || p < r_.p_lo_ - pm;
+      if (edge_ >= 0 || q_out || p_out) {
+        const bool left_q = edge_ >= 0 ? edge_ < 2 : q_out;
         return fmt::format("left the {} range at {} = {:.10g}, {} = {:.10g}",
-                           r_.options_.second.name(), r_.options_.first.name(), p,
-                           r_.options_.second.name(), q);
-      }
-      if (p > r_.p_hi_ + pm || p < r_.p_lo_ - pm) {
-        return fmt::format("left the {} range at {} = {:.10g}, {} = {:.10g}",
-                           r_.options_.first.name(), r_.options_.first.name(), p,
-                           r_.options_.second.name(), q);
+                           (left_q ? r_.options_.second : r_.options_.first).name(),
+                           r_.options_.first.name(), p, r_.options_.second.name(), q);
       }
       if (r_.type_ == CurveType::neimark_sacker) {
         const double kappa = point.u(point.u.size() - 1);
@@ -631,6 +667,7 @@ class CurvesRunner {
     CurvesRunner& r_;
     const CurvePt& first_;
     bool closed_ = false;
+    int edge_ = -1;  // the edge the last point was clipped onto (clip's numbering), or -1
   };
 
   // Where the curve crosses the branch's Q between two points, located: a bifurcation of the
@@ -738,11 +775,23 @@ class CurvesRunner {
                           1e-6 * std::max({std::abs(a.tests[index]), std::abs(b.tests[index]),
                                            1e-300});
     if (!zero.located || jump) {
-      note(fmt::format("curve {}: a {} point between {} = {:.10g} and {:.10g} was detected, not "
-                       "located{}",
-                       curve_, test.type, options_.first.name(), system_->p(a.u),
-                       system_->p(b.u), jump ? " (its test function jumps there)" : ""));
+      note(fmt::format("curve {}: a {} point{} between {} = {:.10g} and {:.10g} was detected, "
+                       "not located{}",
+                       curve_, test.type,
+                       test.kind == Test::Kind::gap ? " (" + gap_detail(test.spring, test.at_largest) + ")"
+                                                    : std::string(),
+                       options_.first.name(), system_->p(a.u), system_->p(b.u),
+                       jump ? " (its test function jumps there)" : ""));
       return;
+    }
+    // On a Neimark–Sacker curve, det(M ∓ I) also vanishes where the pair itself reaches ±1 (κ =
+    // ±1): that is the 1:1 or 1:2 resonance, which the κ test records, not a fold or flip of
+    // another multiplier alongside the pair.
+    if (type_ == CurveType::neimark_sacker &&
+        (test.kind == Test::Kind::det_minus || test.kind == Test::Kind::det_plus)) {
+      const double kappa = at.u(at.u.size() - 1);
+      const double resonance = test.kind == Test::Kind::det_minus ? 1.0 : -1.0;
+      if (std::abs(kappa - resonance) <= 1e-6) return;
     }
     // The same point found on another curve already: one row, with both curves.
     const double pm = 1e-6 * (p_hi_ - p_lo_), qm = 1e-6 * (q_hi_ - q_lo_);

@@ -29,24 +29,8 @@ bool ContinuationOptions::is_valid(std::string* why) const {
     *why = fmt::format("range {}:{} must be two different finite values", start, end);
     return false;
   }
-  for (const auto& [name, value] : {std::pair{"initial step", initial_step},
-                                    std::pair{"min step", min_step},
-                                    std::pair{"max step", max_step}}) {
-    if (!(value >= 0) || !std::isfinite(value)) {
-      *why = fmt::format("{} = {} must be >= 0 and finite (0: the default)", name, value);
-      return false;
-    }
-  }
-  if (max_points < 2) {
-    *why = fmt::format("max points = {} must be >= 2", max_points);
-    return false;
-  }
-  if (max_corrections < 2) {
-    *why = fmt::format("max corrections = {} must be >= 2", max_corrections);
-    return false;
-  }
-  if (!(locate_tolerance > 0) || !std::isfinite(locate_tolerance)) {
-    *why = fmt::format("locate tolerance = {} must be positive and finite", locate_tolerance);
+  if (!walk_settings_valid(initial_step, min_step, max_step, max_points, max_corrections,
+                           locate_tolerance, why)) {
     return false;
   }
   if (max_branches < 0) {

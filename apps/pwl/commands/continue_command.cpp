@@ -28,6 +28,7 @@
 #include "commands/sweep_command.hpp"
 #include "output/gnuplot.hpp"
 #include "output/csv_writer.hpp"
+#include "output/progress_line.hpp"
 #include "parallel/stop_signals.hpp"
 #include "pwl/errors.hpp"
 #include "pwl/orbits/continuation.hpp"
@@ -85,10 +86,7 @@ class ContinueOutputs : public orbits::ContinuationObserver {
         branch_(folder + "/branch.csv", branch_columns()),
         section_(folder + "/branch_section.csv", section_columns()),
         bifurcations_(folder + "/bifurcations.csv", bifurcation_columns()),
-        progress_(progress),
-        tty_(::isatty(STDERR_FILENO) != 0),
-        start_(std::chrono::steady_clock::now()),
-        last_(start_) {}
+        progress_(progress) {}
 
   std::vector<std::string> branch_columns() const {
     std::vector<std::string> c{"branch", "parameter", "period", "stable", "max_abs_multiplier"};
@@ -166,9 +164,7 @@ class ContinueOutputs : public orbits::ContinuationObserver {
     for (const orbits::Bifurcation& b : all) csv.row(bifurcation_row(b));
   }
 
-  void finish_progress() {
-    if (progress_ && tty_ && drawn_) std::fputc('\n', stderr);
-  }
+  void finish_progress() { progress_.finish(); }
 
   long points() const { return points_; }
   const std::map<int, long>& per_branch() const { return per_branch_; }
@@ -218,22 +214,10 @@ class ContinueOutputs : public orbits::ContinuationObserver {
   }
 
   void show(const orbits::BranchPoint& p) {
-    if (!progress_) return;
-    const auto now = std::chrono::steady_clock::now();
-    // A terminal gets one line redrawn ten times a second; a log a line every five seconds.
-    if (now - last_ < std::chrono::milliseconds(tty_ ? 100 : 5000) && points_ > 1) return;
-    last_ = now;
-    const double seconds = std::chrono::duration<double>(now - start_).count();
-    const std::string text =
-        fmt::format("continue: {} points, branch {} (period {}), {} = {:.6g}, {:.1f} s",
-                    points_, p.branch, p.orbit.period, parameter_.name(), p.parameter, seconds);
-    if (tty_) {
-      fmt::print(stderr, "\r{:<78}", text);
-      drawn_ = true;
-    } else {
-      fmt::print(stderr, "{}\n", text);
-    }
-    std::fflush(stderr);
+    if (!progress_.due(points_ <= 1)) return;
+    progress_.show(fmt::format("continue: {} points, branch {} (period {}), {} = {:.6g}, {:.1f} s",
+                               points_, p.branch, p.orbit.period, parameter_.name(), p.parameter,
+                               progress_.seconds()));
   }
 
   std::string folder_;
@@ -245,10 +229,7 @@ class ContinueOutputs : public orbits::ContinuationObserver {
   FlushedCsv branch_;
   FlushedCsv section_;
   FlushedCsv bifurcations_;
-  bool progress_;
-  bool tty_;
-  bool drawn_ = false;
-  std::chrono::steady_clock::time_point start_, last_;
+  ProgressLine progress_;
   long points_ = 0;
   std::map<int, long> per_branch_, stable_;
   std::map<int, std::pair<double, double>> range_;

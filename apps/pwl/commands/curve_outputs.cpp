@@ -4,6 +4,7 @@
 #include <fmt/ranges.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -46,10 +47,7 @@ CurveOutputs::CurveOutputs(const std::string& folder, const orbits::CurvesOption
       dofs_(dofs),
       curves_(folder + "/curves.csv", curve_columns(options, dofs)),
       codim2_(folder + "/codim2.csv", codim2_columns(options)),
-      progress_(progress),
-      tty_(::isatty(STDERR_FILENO) != 0),
-      start_(std::chrono::steady_clock::now()),
-      last_(start_) {
+      progress_(progress) {
   folder_ = folder;
 }
 
@@ -64,22 +62,11 @@ void CurveOutputs::point(const orbits::CurvePointRecord& p) {
   for (int i = 0; i < dofs_; ++i) row += "," + field(p.amplitude(i));
   for (Index i = 0; i < p.state.size(); ++i) row += "," + full_precision(p.state(i));
   curves_.row(row);
-  if (progress_) {
-    const auto now = std::chrono::steady_clock::now();
-    if (now - last_ >= std::chrono::milliseconds(tty_ ? 100 : 5000) || p.curve != last_curve_) {
-      last_ = now;
-      const std::string text = fmt::format(
-          "curves: {} points, curve {} ({}), {} = {:.6g}, {} = {:.6g}, {:.1f} s", curves_.rows(),
-          p.curve, orbits::curve_type_name(p.type), options_.first.name(), p.p,
-          options_.second.name(), p.q, std::chrono::duration<double>(now - start_).count());
-      if (tty_) {
-        fmt::print(stderr, "\r{:<78}", text);
-        drawn_ = true;
-      } else {
-        fmt::print(stderr, "{}\n", text);
-      }
-      std::fflush(stderr);
-    }
+  if (progress_.due(p.curve != last_curve_)) {
+    progress_.show(fmt::format("curves: {} points, curve {} ({}), {} = {:.6g}, {} = {:.6g}, {:.1f} s",
+                               curves_.rows(), p.curve, orbits::curve_type_name(p.type),
+                               options_.first.name(), p.p, options_.second.name(), p.q,
+                               progress_.seconds()));
   }
   last_curve_ = p.curve;
   stop_on_signal(folder_);
@@ -92,9 +79,7 @@ void CurveOutputs::codim2(const orbits::Codim2Point& c) {
                           fmt::join(curves, ";"), c.detail));
 }
 
-void CurveOutputs::finish_progress() {
-  if (progress_ && tty_ && drawn_) std::fputc('\n', stderr);
-}
+void CurveOutputs::finish_progress() { progress_.finish(); }
 
 void print_curves(const orbits::CurvesResult& result, const orbits::CurvesOptions& options) {
   fmt::print("curves ({}) in ({}, {}):\n", result.curves.size(), options.first.name(),
@@ -132,10 +117,13 @@ void draw_curves(const std::string& folder, const orbits::CurvesOptions& options
   const auto definitions = [&](const std::string& format) {
     return fmt::format(
         "curves='{0}/curves.csv'; codim2='{0}/codim2.csv'; ncodim2={5}; "
-        "out='{0}/bifurcation_curves.{1}'; xname={2}; yname={3}; title={4}",
+        "out='{0}/bifurcation_curves.{1}'; xname={2}; yname={3}; title={4}; "
+        "xlo={6:.17g}; xhi={7:.17g}; ylo={8:.17g}; yhi={9:.17g}",
         folder, format, gnuplot_quoted(parameter_label(options.first)),
         gnuplot_quoted(parameter_label(options.second)), gnuplot_quoted(title),
-        result.codim2.size());
+        result.codim2.size(), std::min(options.p_from, options.p_to),
+        std::max(options.p_from, options.p_to), std::min(options.q_from, options.q_to),
+        std::max(options.q_from, options.q_to));
   };
   draw_figure_and_report(scripts_directory() + "/bifurcation_curves.gp", definitions,
                          folder + "/bifurcation_curves", "pwl continue", false);

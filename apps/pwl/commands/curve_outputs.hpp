@@ -12,11 +12,11 @@
 //               the orbit's state at t = 0 mod kT, from which any point can be solved again.
 //   codim2.csv  type,<P>,<Q>,curves,detail
 //               one row per codimension-two point, the curves it was found on joined by ';'.
-#include <chrono>
 #include <string>
 #include <vector>
 
 #include "output/csv_writer.hpp"
+#include "output/progress_line.hpp"
 #include "pwl/orbits/bifurcation_curves.hpp"
 
 namespace pwl::app {
@@ -37,9 +37,8 @@ class CurveOutputs : public orbits::CurvesObserver {
   std::string folder_;
   FlushedCsv curves_;
   FlushedCsv codim2_;
-  bool progress_, tty_, drawn_ = false;
+  ProgressLine progress_;
   int last_curve_ = -1;
-  std::chrono::steady_clock::time_point start_, last_;
 };
 
 // Stops the run on SIGINT or SIGTERM (parallel/stop_signals.hpp) between two rows: throws Stopped

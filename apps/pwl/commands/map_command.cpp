@@ -3,7 +3,9 @@
 // heatmap.
 #include <fmt/format.h>
 
+#include <fstream>
 #include <memory>
+#include <sstream>
 
 #include "commands/cli_checks.hpp"
 #include "commands/flag_relations.hpp"
@@ -18,8 +20,41 @@
 namespace pwl::app {
 namespace {
 
+// The curves of --curves for the map's figure: the gnuplot definitions, with the columns of
+// curves.csv drawn across and up (3 and 4, or 4 and 3 when the map has the curves' parameters the
+// other way round). Throws InputError naming --curves when the folder has no curves.csv or its
+// parameters are not the map's.
+std::string curves_over_map(const std::string& folder, const analysis::RegimeMapOptions& o) {
+  const std::string path = folder + "/curves.csv";
+  std::ifstream in(path);
+  std::string header;
+  if (!in || !std::getline(in, header)) {
+    throw InputError(fmt::format("--curves {}: no {} (a folder of pwl continue --curves)", folder,
+                                 path));
+  }
+  std::vector<std::string> columns;
+  std::stringstream fields(header);
+  for (std::string c; std::getline(fields, c, ',');) columns.push_back(c);
+  const std::string x = o.first.parameter.name(), y = o.second.parameter.name();
+  if (columns.size() < 4 || !((columns[2] == x && columns[3] == y) ||
+                              (columns[2] == y && columns[3] == x))) {
+    throw InputError(fmt::format("--curves {}: its curves are in ({}, {}), the map in ({}, {})",
+                                 folder, columns.size() > 2 ? columns[2] : "?",
+                                 columns.size() > 3 ? columns[3] : "?", x, y));
+  }
+  long codim2 = -1;  // rows after the header
+  std::ifstream points(folder + "/codim2.csv");
+  for (std::string line; std::getline(points, line);) ++codim2;
+  return fmt::format("; curves='{0}/curves.csv'; codim2='{0}/codim2.csv'; ncodim2={1}; "
+                     "xcol={2}; ycol={3}",
+                     folder, std::max(codim2, 0L), columns[2] == x ? 3 : 4,
+                     columns[2] == x ? 4 : 3);
+}
+
+
 void map(const MapFlags& f) {
   const analysis::RegimeMapOptions o = map_options(f);
+  const std::string curves = f.curves.empty() ? "" : curves_over_map(f.curves, o);
   Study study = study_of(o);
   study.finish = [&](const std::map<long, analysis::PointResult>& records) {
     analysis::write_map_file(o, records, f.run.out);
@@ -32,12 +67,13 @@ void map(const MapFlags& f) {
     const auto definitions = [&](const std::string& format) {
       return fmt::format(
           "data='{0}/map.csv'; out='{0}/regime_map.{6}'; out_lambda='{0}/lambda1_map.{6}'; "
-          "xname='{1}'; yname='{2}'; dx={3:.17g}; dy={4:.17g}; subtitle={5}{7}",
+          "xname='{1}'; yname='{2}'; dx={3:.17g}; dy={4:.17g}; subtitle={5}{7}{8}",
           f.run.out, parameter_label(o.first.parameter), parameter_label(o.second.parameter), dx,
           dy, gnuplot_quoted(study_title(o.model(), o.point)), format,
           o.point.starts > 1
               ? fmt::format("; out_attractors='{}/attractors_map.{}'", f.run.out, format)
-              : std::string());
+              : std::string(),
+          curves);
     };
     if (draw_figure(scripts_directory() + "/regime_map.gp", definitions, &why)) {
       fmt::print("wrote {0}/regime_map.png, {0}/lambda1_map.png{1} and their .svg\n", f.run.out,
@@ -112,7 +148,11 @@ void add_map_flags(CLI::App& c, MapFlags& flags) {
                     "accepted: --phase sets the stroboscopic points each cell is classified on");
   add_initial_state_flags(c, flags.start);
   add_run_flags(c, flags.run);
+  c.add_option("--curves", flags.curves,
+               "Draw over the regime map the bifurcation curves of this folder (written by\n"
+               "pwl continue --curves in the map's two parameters)");
 }
+
 
 void add_map_command(CLI::App& app) {
   auto flags = std::make_shared<MapFlags>();

@@ -33,6 +33,7 @@ struct MapFlags {
   std::string y_range = "1:15";
   int y_points = 15;
   std::string mode = "independent";
+  std::string curves;  // a pwl continue --curves folder whose curves the figure draws
   MapFlags() { run.out = "map"; }
 };
 

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -46,6 +47,42 @@ std::string bifurcation_table(const std::string& csv) {
                          f[3], f[4], multiplier, f[8]);
   }
   return table;
+}
+
+// The curves of a pwl continue --curves folder in Markdown: how many of each type, then one row per
+// codimension-two point (codim2.csv), in the order found.
+std::string curves_table(const std::string& folder) {
+  std::map<std::string, std::set<std::string>> kinds;  // type -> curve ids
+  {
+    std::ifstream in(folder + "/curves.csv");
+    if (!in) throw Error(fmt::format("cannot read {}/curves.csv", folder));
+    std::string line;
+    std::getline(in, line);
+    while (std::getline(in, line)) {
+      std::stringstream fields(line);
+      std::string curve, type;
+      std::getline(fields, curve, ',');
+      std::getline(fields, type, ',');
+      kinds[type].insert(curve);
+    }
+  }
+  std::string text = "Curves followed:";
+  for (const auto& [type, ids] : kinds) text += fmt::format(" {} {};", ids.size(), type);
+  text.back() = '.';
+  text += "\n\n| type | θ | α | curves | detail |\n|---|---|---|---|---|\n";
+  std::ifstream in(folder + "/codim2.csv");
+  if (!in) throw Error(fmt::format("cannot read {}/codim2.csv", folder));
+  std::string line;
+  std::getline(in, line);  // header
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream fields(line);
+    for (std::string cell; std::getline(fields, cell, ',');) f.push_back(cell);
+    if (f.size() < 4) throw Error(fmt::format("{}/codim2.csv: a short row: {}", folder, line));
+    text += fmt::format("| {} | {:.10f} | {:.10f} | {} | {} |\n", f[0], std::stod(f[1]),
+                        std::stod(f[2]), f[3], f.size() > 4 ? f[4] : "");
+  }
+  return text;
 }
 
 struct ReproduceOptions {
@@ -176,7 +213,7 @@ void reproduce(const ReproduceOptions& options) {
       o.quick ? " --quick (a smoke run: shorter runs, a 200-mass chain, small grids; not the "
                 "paper's settings)"
               : "");
-  std::string five_dof, regimes, chain, charts, bifurcations;
+  std::string five_dof, regimes, chain, charts, bifurcations, curves;
   int done = 0, wanted = 0;
   // Seconds spent on the paper's scenes and on pwl's own studies, and how many of each ran.
   double part_seconds[2] = {0.0, 0.0};
@@ -190,12 +227,20 @@ void reproduce(const ReproduceOptions& options) {
   for (const ReproducedScene& s : scenes) {
     if (!o.only.empty() && std::count(o.only.begin(), o.only.end(), s.key) == 0) continue;
     const std::string out = fmt::format("{}/{}", data, fs::path(s.scene).stem().string());
-    fs::remove_all(out);  // a fresh run: sweeps and maps would otherwise ask for --resume
+    // A fresh run (sweeps and maps would otherwise ask for --resume), unless the scene continues
+    // an earlier one's (the same scene file, so the same folder).
+    if (s.continues.empty()) {
+      fs::remove_all(out);
+    } else if (!fs::exists(out)) {
+      throw InputError(fmt::format("--only {0}: it draws again over the run of {1}, which {2} has "
+                                   "not: run --only {1},{0}",
+                                   s.key, s.continues, data));
+    }
     fmt::print("[{}/{}] pwl run {}/{}{}\n", ++done, wanted, scenes_directory(), s.scene,
                o.quick ? " (quick)" : "");
     std::fflush(stdout);
     const auto start = std::chrono::steady_clock::now();
-    const std::string printed = run_scene(self, s, out, o.quick);
+    const std::string printed = run_scene(self, s, out, data, o.quick);
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     copy_figures(s, out, figures);
@@ -243,6 +288,7 @@ void reproduce(const ReproduceOptions& options) {
       for (const auto& [made, name] : s.figures)
         charts += fmt::format("- {}: `{}`\n", name, s.scene);
       if (s.key == "continuation") bifurcations = bifurcation_table(out + "/bifurcations.csv");
+      if (s.key == "theta-alpha-curves") curves = curves_table(out);
     }
     fmt::print("  done in {:.1f} s\n", seconds);
     part_seconds[s.paper ? 0 : 1] += seconds;
@@ -292,6 +338,15 @@ void reproduce(const ReproduceOptions& options) {
         "bifurcations.csv). Spring j is the gap spring of mass j.\n\n" +
         bifurcations;
   }
+  if (!curves.empty()) {
+    report +=
+        "\n## The 5-DOF chain's bifurcation curves in (θ, α) (pwl continue --curves)\n\n"
+        "Figure 5's chain, its period-1 branch in θ over [0.5, 3] at α = 5, and every fold, period "
+        "doubling, Neimark–Sacker point and grazing located on it followed in (θ, α) over α in "
+        "[1, 15]; their codimension-two points (pwl continue's codim2.csv), each located on its "
+        "curves. Spring j is the gap spring of mass j.\n\n" +
+        curves;
+  }
   // Only the whole run replaces plots/report.md.
   const std::string path = o.quick          ? data + "/report_quick.md"
                            : o.only.empty() ? plots + "/report.md"
@@ -309,7 +364,7 @@ void add_reproduce_command(CLI::App& app) {
       "Run every shipped scene of the paper's figures and table, draw them under plots/figures and\n"
       "report what matched the paper (plots/report.md)\n"
       "The paper's figures and table come first (about 30 s on 2 idle cores), pwl's own studies\n"
-      "after them (about 4 minutes); each is printed with its time.\n"
+      "after them (about 5 minutes); each is printed with its time.\n"
       "Example: pwl reproduce\n"
       "         pwl reproduce --only paper    (the paper's figures and table only)\n"
       "         pwl reproduce --only 4a,7-9\n"
@@ -318,7 +373,9 @@ void add_reproduce_command(CLI::App& app) {
   c->add_flag("--quick", options->quick, "Short runs, for smoke tests");
   c->add_option("--only", options->only,
                 "Only these: 4a, 4b, 5, 6, 7-9 (or paper: all five), theta-sweep,\n"
-                "theta-alpha-map, continuation, basins (or studies: all four)")
+                "theta-alpha-map, continuation, basins, theta-alpha-curves,\n"
+                "theta-alpha-map-curves (or studies: all six; the last draws the map of\n"
+                "theta-alpha-map again, with the curves of theta-alpha-curves over it)")
       ->delimiter(',');
   c->callback([options] { reproduce(*options); });
 }

@@ -23,6 +23,10 @@ struct ReproducedScene {
   std::vector<std::pair<std::string, std::string>> figures;
   // One of the paper's figures or its table (run first), or one of pwl's own studies.
   bool paper = false;
+  // The key of an earlier scene whose output folder this run continues in (--resume, to draw it
+  // again with more over it) instead of a fresh folder of its own; "" for none. In `always` and
+  // `quick`, {data} stands for the folder every scene's output goes under.
+  std::string continues;
 };
 
 // Every scene `pwl reproduce` runs, in order: the paper's figures and table first (`paper`), then
@@ -33,7 +37,7 @@ const std::vector<ReproducedScene>& reproduced_scenes();
 // Runs `scene` through this very program (`self`: its path), its output under `out`, with the
 // quick overrides when asked. Returns what it printed; throws Error when the run fails.
 std::string run_scene(const std::string& self, const ReproducedScene& scene,
-                      const std::string& out, bool quick);
+                      const std::string& out, const std::string& data, bool quick);
 
 // The rest of the line after `prefix` in `text` ("" when absent).
 std::string line_after(const std::string& text, const std::string& prefix);

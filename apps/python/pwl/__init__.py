@@ -216,14 +216,24 @@ class ContinuationResult(_Result):
         multiplier (complex, NaN for a grazing), abs_multiplier, detail, located, at_largest_gap,
         to_branch, joined_by (-1 for none), test_value, state (bifurcations, 2n)
     notes: why each branch stopped
+    curves (with curves=(Q, (FROM, TO))): curves.csv as a dict of columns: curve, type, the two
+        parameters by name, period, spring (1-based, 0 for none), multiplier (complex), kappa,
+        amplitude (rows, n), state (rows, 2n); None without curves=
+    codim2: codim2.csv as a dict of columns: type, the two parameters by name, curves (the curves
+        each point was found on), detail, state; None without curves=
+    curve_ends: for each curve, why it ended each way; curve_notes: the curves' notes
     parameter_name, method, method_default, description
     """
 
     def _summary(self):
         kinds = _counts(self.bifurcations["type"]) if len(self.bifurcations["type"]) else "none"
-        return "{}: {} points on {} branch(es), {} stable; bifurcations: {}".format(
+        text = "{}: {} points on {} branch(es), {} stable; bifurcations: {}".format(
             self.parameter_name, len(self.parameter), len(_np.unique(self.branch)),
             int(_np.sum(self.stable)), kinds)
+        if self.curves is not None:
+            text += "; {} curve(s), {} points, {} codimension-two point(s)".format(
+                len(self.curve_ends), len(self.curves["curve"]), len(self.codim2["type"]))
+        return text
 
     def __init__(self, fields):
         fields["stable"] = fields["stable"].astype(bool)
@@ -232,6 +242,11 @@ class ContinuationResult(_Result):
             table[key] = _text(table[key])
         for key in ("located", "at_largest_gap"):
             table[key] = table[key].astype(bool)
+        for name in ("curves", "codim2"):
+            if fields.get(name) is not None:
+                fields[name]["type"] = _text(fields[name]["type"])
+        if fields.get("codim2") is not None:
+            fields["codim2"]["detail"] = _text(fields["codim2"]["detail"])
         super().__init__(fields)
 
 

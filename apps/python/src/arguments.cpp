@@ -46,6 +46,16 @@ bool is_range_flag(const std::string& flag) {
          flag.compare(flag.size() - kRange.size(), kRange.size(), kRange) == 0;
 }
 
+bool is_list(const py::handle& value);
+
+// A pair (name, (from, to)): a parameter and its range.
+bool is_named_range(const py::handle& value) {
+  if (!py::isinstance<py::tuple>(value) && !py::isinstance<py::list>(value)) return false;
+  const py::sequence pair = py::reinterpret_borrow<py::sequence>(value);
+  if (pair.size() != 2 || !py::isinstance<py::str>(pair[0]) || !is_list(pair[1])) return false;
+  return py::len(pair[1]) == 2;
+}
+
 bool is_list(const py::handle& value) {
   return !py::isinstance<py::str>(value) && !py::isinstance<py::bytes>(value) &&
          (py::isinstance<py::list>(value) || py::isinstance<py::tuple>(value) ||
@@ -96,7 +106,15 @@ void parse_keywords(CLI::App& app, const std::string& function, const py::dict& 
       continue;
     }
     std::string text;
-    if (is_range_flag(flag) && is_list(value)) {
+    if (is_named_range(value)) {
+      // (NAME, (FROM, TO)): the command line's NAME=FROM:TO (--curves alpha=1:15).
+      const py::sequence pair = py::reinterpret_borrow<py::sequence>(value);
+      const py::list range = py::isinstance<py::array>(pair[1])
+                                 ? py::list(pair[1].attr("tolist")())
+                                 : py::list(py::reinterpret_borrow<py::object>(pair[1]));
+      text = pair[0].cast<std::string>() + "=" + item_text(range[0], function, keyword) + ":" +
+             item_text(range[1], function, keyword);
+    } else if (is_range_flag(flag) && is_list(value)) {
       // (FROM, TO): the command line's FROM:TO.
       const py::list items = py::isinstance<py::array>(value)
                                  ? py::list(value.attr("tolist")())

@@ -11,6 +11,8 @@
 //   - a list, tuple or 1-D NumPy array: its items joined by commas (--loads=1,-1,1,-1,1);
 //   - a range (a flag named *range, FROM:TO on the command line): a pair of numbers, (0.5, 3) for
 //     --range=0.5:3, or the string as written.
+//   - a parameter and its range, NAME=FROM:TO on the command line: a pair of the name and a pair of
+//     numbers, ("alpha", (1, 15)) for --curves=alpha=1:15.
 // A keyword that names no flag of the job raises TypeError naming it; a value the CLI refuses
 // raises pwl.InputError with the CLI's message ("--n: must be a positive number, got 0").
 #include <pybind11/pybind11.h>

@@ -122,6 +122,78 @@ class Checkpoints : public orbits::ContinuationObserver {
   Interrupt interrupt_;
 };
 
+// Ctrl-C looked at after every point of a bifurcation curve.
+class CurveCheckpoints : public orbits::CurvesObserver {
+ public:
+  void point(const orbits::CurvePointRecord&) override { interrupt_.poll(); }
+
+ private:
+  Interrupt interrupt_;
+};
+
+// The curves and codimension-two points as dicts of columns, as curves.csv and codim2.csv have
+// them (the parameters by their names; multipliers complex; amplitude and state as rows).
+void add_curves(py::dict& d, const orbits::CurvesResult& r, const orbits::CurvesOptions& o,
+                Index n) {
+  const std::string p = o.first.name(), q = o.second.name();
+  py::dict curves;
+  py::list type;
+  std::vector<int> curve, period, spring;
+  std::vector<double> pv, qv, kappa, amplitude, state;
+  std::vector<std::complex<double>> multiplier;
+  for (const orbits::CurvePointRecord& c : r.points) {
+    curve.push_back(c.curve);
+    type.append(orbits::curve_type_name(c.type));
+    pv.push_back(c.p);
+    qv.push_back(c.q);
+    period.push_back(c.period);
+    spring.push_back(c.spring + 1);
+    multiplier.push_back(c.multiplier);
+    kappa.push_back(c.kappa);
+    amplitude.insert(amplitude.end(), c.amplitude.data(), c.amplitude.data() + n);
+    state.insert(state.end(), c.state.data(), c.state.data() + 2 * n);
+  }
+  const auto rows = static_cast<py::ssize_t>(r.points.size());
+  curves["curve"] = int_array(curve);
+  curves["type"] = type;
+  curves[p.c_str()] = vector_array(pv);
+  curves[q.c_str()] = vector_array(qv);
+  curves["period"] = int_array(period);
+  curves["spring"] = int_array(spring);
+  curves["multiplier"] = complex_array(multiplier);
+  curves["kappa"] = vector_array(kappa);
+  curves["amplitude"] = rows_array(amplitude, rows, n);
+  curves["state"] = rows_array(state, rows, 2 * n);
+  d["curves"] = curves;
+  py::dict codim2;
+  py::list ctype, detail, on;
+  std::vector<double> cp, cq, cstate;
+  for (const orbits::Codim2Point& c : r.codim2) {
+    ctype.append(c.type);
+    detail.append(c.detail);
+    cp.push_back(c.p);
+    cq.push_back(c.q);
+    py::list ids;
+    for (int id : c.curves) ids.append(id);
+    on.append(ids);
+    cstate.insert(cstate.end(), c.state.data(), c.state.data() + 2 * n);
+  }
+  codim2["type"] = ctype;
+  codim2[p.c_str()] = vector_array(cp);
+  codim2[q.c_str()] = vector_array(cq);
+  codim2["curves"] = on;
+  codim2["detail"] = detail;
+  codim2["state"] = rows_array(cstate, static_cast<py::ssize_t>(r.codim2.size()), 2 * n);
+  d["codim2"] = codim2;
+  py::list ends, notes;
+  for (const orbits::CurveSummary& c : r.curves) {
+    ends.append(py::make_tuple(c.ends[0], c.ends[1]));
+  }
+  for (const std::string& note : r.notes) notes.append(note);
+  d["curve_ends"] = ends;
+  d["curve_notes"] = notes;
+}
+
 py::dict continuation(py::kwargs kwargs) {
   py::dict args(kwargs);
   const auto file = take_structure(args);
@@ -143,6 +215,15 @@ py::dict continuation(py::kwargs kwargs) {
     Checkpoints checkpoints;
     result = orbits::continue_periodic_orbit(problem.base, guess, problem.options, &checkpoints);
   });
+  orbits::CurvesResult curves;
+  if (problem.curves) {
+    const std::vector<orbits::Bifurcation> starts = app::curve_starts(problem, result.bifurcations);
+    without_gil([&] {
+      CurveCheckpoints checkpoints;
+      curves = orbits::follow_bifurcation_curves(problem.base, starts, *problem.curves,
+                                                 &checkpoints);
+    });
+  }
   const auto count = static_cast<py::ssize_t>(result.points.size());
   const Index n = problem.base.dofs();
   std::vector<int> branch, period, stable, unstable, iterations;
@@ -232,6 +313,14 @@ py::dict continuation(py::kwargs kwargs) {
   py::list notes;
   for (const std::string& note : result.notes) notes.append(note);
   d["notes"] = notes;
+  if (problem.curves) {
+    add_curves(d, curves, *problem.curves, n);
+  } else {
+    d["curves"] = py::none();
+    d["codim2"] = py::none();
+    d["curve_ends"] = py::list();
+    d["curve_notes"] = py::list();
+  }
   d["parameter_name"] = problem.parameter.name();
   d["method"] = app::orbit_method_label(problem.method);
   d["method_default"] = problem.method.chosen;

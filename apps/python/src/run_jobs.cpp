@@ -48,6 +48,7 @@ const LeftOut kMapLeftOut{
     {"--resume", "pwl.map keeps no journal to resume from"},
     {"--quiet", "pwl.map shows no progress bar"},
     {"--no-plot", "pwl.map draws nothing"},
+    {"--curves", "pwl.map draws nothing (pwl.continue_(curves=...) returns the curves)"},
 };
 
 // The flags pwl.simulate takes: pwl simulate's, less those it leaves out.

@@ -130,6 +130,12 @@ struct StepControl {
   }
 };
 
+// The settings every walk along a curve takes from its options, checked once for all of them:
+// the steps >= 0 and finite (0: the problem's default), at least 2 points and 2 corrections, a
+// positive finite tolerance for locating zeros. False with *why naming the setting and its value.
+bool walk_settings_valid(double initial_step, double min_step, double max_step, int max_points,
+                         int max_corrections, double locate_tolerance, std::string* why);
+
 // A point of a curve as the walk below handles it; problems derive their points from it.
 struct CurvePoint {
   Vector u;
