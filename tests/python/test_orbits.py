@@ -29,6 +29,20 @@ def test_orbit_equals_the_cli_files(cli):
                        np.sort_complex(o.multipliers), atol=1e-10)
 
 
+def test_minimal_period_of_a_slow_spiral():
+    # Figure 5's chain at alpha = 4.7, theta = 1.83: a stable period-1 orbit whose complex pair
+    # (|mu| = 0.987) turns about 2/7 of a circle a period. Newton at period 7 lands on it: the
+    # orbit is the period-1 orbit taken 7 times, its multipliers at period 1 the 7th roots of
+    # those at period 7 in modulus.
+    seven = pwl.orbit(figure="5", alpha=4.7, theta=1.83, period=7)
+    assert seven.period == 7 and seven.minimal_period == 1
+    one = pwl.orbit(figure="5", alpha=4.7, theta=1.83, period=1)
+    assert one.minimal_period == 1
+    assert abs(seven.minimal_largest_modulus - one.largest_modulus) <= 1e-10
+    assert abs(seven.largest_modulus - one.largest_modulus ** 7) <= 1e-10
+    assert "(minimal period 1)" in repr(seven) and "minimal" not in repr(one)
+
+
 def test_continuation_equals_the_cli_files(cli):
     c = pwl.continue_(figure="4a", parameter="theta", range="0.9:1.1")
     out = cli.out("continue", "--figure", "4a", "--parameter", "theta", "--range", "0.9:1.1",

@@ -188,19 +188,9 @@ OrbitRefinement refine_orbit(StroboscopicMap& map, const std::vector<Vector>& po
     shooting.period = k;
     shooting.multipliers = true;
     try {
-      PeriodicOrbit orbit = find_periodic_orbit(map, last_state, shooting);
-      // The least period: the shortest divisor j of k with φ_{jT}(y) = y to Newton's tolerance.
-      const double scale = shooting.tolerance * std::max(1.0, inf_norm(orbit.state));
-      for (int j = 1; j < k; ++j) {
-        if (k % j != 0) continue;
-        if (inf_norm(map.advance(orbit.state, j) - orbit.state) <= 10 * scale) {
-          shooting.period = j;
-          orbit = find_periodic_orbit(map, orbit.state, shooting);
-          break;
-        }
-      }
+      // Reduced to its least period (at_minimal_period).
+      r.orbit = at_minimal_period(map, find_periodic_orbit(map, last_state, shooting), shooting);
       r.found = true;
-      r.orbit = std::move(orbit);
       assess(map, last_state, options, r);
       if (r.explains_motion()) return r;
       if (!first.found) first = r;

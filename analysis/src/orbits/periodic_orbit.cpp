@@ -323,4 +323,19 @@ PeriodicOrbit find_periodic_orbit(StroboscopicMap& map, const Vector& guess,
   }
 }
 
+PeriodicOrbit at_minimal_period(StroboscopicMap& map, const PeriodicOrbit& orbit,
+                                const ShootingOptions& options) {
+  const int k = orbit.period;
+  const double scale = 1e3 * options.tolerance * std::max(1.0, inf_norm(orbit.state));
+  for (int m = 1; m < k; ++m) {
+    if (k % m != 0) continue;
+    if (inf_norm(map.advance(orbit.state, m) - orbit.state) > scale) continue;
+    ShootingOptions reduced = options;
+    reduced.period = m;
+    if (m % reduced.shots != 0) reduced.shots = 1;
+    return find_periodic_orbit(map, orbit.state, reduced);
+  }
+  return orbit;
+}
+
 }  // namespace pwl::orbits

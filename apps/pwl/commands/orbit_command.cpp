@@ -57,6 +57,7 @@ void orbit(const OrbitCommandFlags& f) {
   note_when_no_tangent_map(map);
   const Vector guess = starting_guess(o, map);
   const orbits::PeriodicOrbit orbit = orbits::find_periodic_orbit(map, guess, problem.shooting);
+  const orbits::PeriodicOrbit minimal = orbits::at_minimal_period(map, orbit, problem.shooting);
 
   std::filesystem::create_directories(o.out);
   {
@@ -93,6 +94,16 @@ void orbit(const OrbitCommandFlags& f) {
                mu.values.size(), mu.complete ? "all" : "the leading ones, by Arnoldi",
                mu.largest_modulus(), multiplier_text(mu.values.front()),
                orbit.exact_tangent ? "" : ", from forward differences");
+  }
+  if (minimal.period == orbit.period) {
+    fmt::print("minimal period: {}\n", orbit.period);
+  } else {
+    fmt::print("minimal period: {0} (the period-{1} orbit found is the period-{0} orbit taken {2} "
+               "times; solved again at period {0}: residual {3:.3e}{4})\n",
+               minimal.period, orbit.period, orbit.period / minimal.period, minimal.residual,
+               minimal.multipliers.values.empty()
+                   ? std::string()
+                   : fmt::format(", largest |μ| = {:.10g}", minimal.multipliers.largest_modulus()));
   }
   fmt::print("amplitude max|x{}| over the orbit: {:.10g}\n", n, profile.amplitude(n - 1));
   const int outside = mu.unstable_count();

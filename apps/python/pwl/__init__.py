@@ -189,6 +189,8 @@ class OrbitResult(_Result):
     """A periodic orbit by shooting (pwl orbit).
 
     state: [x; v] at t = 0 mod T (orbit.csv); period: k; forcing_period: T
+    minimal_period: the smallest m dividing k whose map closes the orbit (m < k: the orbit found
+        is the period-m orbit taken k/m times); minimal_largest_modulus: its largest |mu| at m
     multipliers: the Floquet multipliers, complex, largest modulus first (floquet.csv);
         multipliers_complete: all of them (else Arnoldi's leading ones); largest_modulus
     stable: every multiplier inside the unit circle; verdict: "stable" or "unstable";
@@ -201,8 +203,11 @@ class OrbitResult(_Result):
     """
 
     def _summary(self):
-        return "period-{} orbit, {}, largest |mu| {:.6g}, residual {:.2g}; {}".format(
-            self.period, self.verdict, self.largest_modulus, self.residual, self.description)
+        minimal = ("" if self.minimal_period == self.period else
+                   " (minimal period {})".format(self.minimal_period))
+        return "period-{} orbit{}, {}, largest |mu| {:.6g}, residual {:.2g}; {}".format(
+            self.period, minimal, self.verdict, self.largest_modulus, self.residual,
+            self.description)
 
 
 class ContinuationResult(_Result):

@@ -79,17 +79,21 @@ py::dict orbit(py::kwargs kwargs) {
   app::read_method_given(app, flags.orbit);
 
   app::OrbitProblem problem = app::orbit_problem(flags);
-  orbits::PeriodicOrbit orbit;
+  orbits::PeriodicOrbit orbit, minimal;
   orbits::OrbitProfile profile;
   without_gil([&] {
     orbits::StroboscopicMap& map = *problem.map;
     const Vector guess = app::starting_guess(flags.orbit, map);
     orbit = orbits::find_periodic_orbit(map, guess, problem.shooting);
+    minimal = orbits::at_minimal_period(map, orbit, problem.shooting);
     profile = orbits::orbit_profile(map, orbit.state, flags.orbit.period);
   });
   py::dict d = multipliers_dict(orbit.multipliers);
   d["state"] = vector_array(orbit.state);
   d["period"] = orbit.period;
+  d["minimal_period"] = minimal.period;
+  d["minimal_largest_modulus"] =
+      minimal.multipliers.values.empty() ? std::nan("") : minimal.multipliers.largest_modulus();
   d["forcing_period"] = orbit.forcing_period;
   d["residual"] = orbit.residual;
   d["iterations"] = orbit.iterations;

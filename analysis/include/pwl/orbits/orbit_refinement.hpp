@@ -24,8 +24,8 @@
 //     reduced to their least period (step 2). A divisor is kept (its Newton is cheaper).
 //  2. Newton on φ_{kT}(y) = y (periodic_orbit.hpp) from the motion's last state, which must be at
 //     phase 0 of the forcing (a whole number of periods after the start). When it converges, the
-//     orbit's least period is checked: if φ_{jT}(y) = y for a divisor j of k (to Newton's
-//     tolerance) the orbit is period-j and is solved again at j.
+//     orbit's least period is checked: if φ_{jT}(y) = y for a divisor j of k (at_minimal_period
+//     in periodic_orbit.hpp says to what tolerance) the orbit is period-j, solved again at j.
 //  3. Where the motion is with respect to the orbit: the distance from its last state to the
 //     nearest of the orbit's k points at phase 0, against `on_orbit_tolerance` (relative to
 //     max(1, |y|_∞)). The orbit is attracting when every multiplier lies inside the unit circle

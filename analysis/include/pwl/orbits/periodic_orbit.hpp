@@ -119,6 +119,20 @@ class ShootingError : public Error {
 PeriodicOrbit find_periodic_orbit(StroboscopicMap& map, const Vector& guess,
                                   const ShootingOptions& options = {});
 
+// The orbit at its minimal period. A period-k request can converge on an orbit of a shorter period
+// m dividing k (the period-1 orbit taken k times, with multipliers μ^k): near a stable period-1
+// orbit whose complex pair turns about p/k of a circle a period, a record's period search can
+// return k, and Newton at k then finds the period-1 orbit. The minimal period is the smallest
+// divisor m of k with |φ_{mT}(y) − y|_∞ <= 1000 · tolerance · max(1, |y|_∞): a genuine period-k
+// orbit's points are apart by far more, unless it is born a hair from the bifurcation that made
+// it; the factor covers the error of a y that met Newton's test at k, where the error in y can be
+// larger than the residual by the conditioning of M^k − I. When m < k the orbit is solved again
+// at m from y (one or two Newton iterations), so that its state, residual and multipliers are
+// those of the period-m orbit; shots are kept when they divide m, else single shooting. One
+// integration of each divisor tried. Returns `orbit` unchanged when its period is minimal.
+PeriodicOrbit at_minimal_period(StroboscopicMap& map, const PeriodicOrbit& orbit,
+                                const ShootingOptions& options);
+
 // The multipliers of the period-k orbit through `state` (no Newton): the dense monodromy or
 // Arnoldi, as `options` says.
 FloquetMultipliers orbit_multipliers(StroboscopicMap& map, const Vector& state,
