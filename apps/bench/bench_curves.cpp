@@ -2,11 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
-#include <regex>
 #include <string>
 #include <vector>
 
@@ -27,10 +27,26 @@ struct CurvesBenchOptions {
   std::string out = "out/bench";
 };
 
-// The number after `prefix` in `text` (NaN when absent).
-double number_after(const std::string& text, const std::string& pattern) {
-  std::smatch m;
-  if (std::regex_search(text, m, std::regex(pattern)) && m.size() > 1) return std::stod(m[1]);
+// The index-th number (0-based) on the line of `text` that follows the first `prefix`, reading
+// unsigned decimals such as 31.28 or 1264 (NaN when absent). Plain string scanning: GCC 12 warns
+// (maybe-uninitialized, an error here) inside <regex> under the sanitizers' -O2.
+double number_after(const std::string& text, const std::string& prefix, int index = 0) {
+  const std::size_t at = text.find(prefix);
+  if (at == std::string::npos) return std::nan("");
+  const std::size_t begin = at + prefix.size();
+  const std::string line = text.substr(begin, text.find('\n', begin) - begin);
+  int seen = 0;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const bool digit = std::isdigit(static_cast<unsigned char>(line[i])) != 0;
+    if (!digit) continue;
+    std::size_t end = i;
+    while (end < line.size() &&
+           (std::isdigit(static_cast<unsigned char>(line[end])) != 0 || line[end] == '.')) {
+      ++end;
+    }
+    if (seen++ == index) return std::stod(line.substr(i, end - i));
+    i = end;
+  }
   return std::nan("");
 }
 
@@ -64,12 +80,12 @@ void run(const CurvesBenchOptions& o) {
                     shell_quoted(curves_scene), shell_quoted(work + "/curves"), curves_sets));
     CurvesRun c;
     c.wall = seconds_since(start);
-    c.branch_seconds = number_after(printed, R"(\ntime: ([0-9.]+) s)");
-    c.branch_points = number_after(printed, R"(\ntime: [0-9.]+ s \(([0-9]+) points\))");
-    c.curves_seconds = number_after(printed, R"(curves' time: ([0-9.]+) s)");
-    c.curve_points = number_after(printed, R"(curves' time: [0-9.]+ s \(([0-9]+) rows\))");
-    c.curves = number_after(printed, R"(\ncurves \(([0-9]+)\))");
-    c.codim2 = number_after(printed, R"(codimension-two points \(([0-9]+)\))");
+    c.branch_seconds = number_after(printed, "\ntime: ", 0);
+    c.branch_points = number_after(printed, "\ntime: ", 1);
+    c.curves_seconds = number_after(printed, "curves' time: ", 0);
+    c.curve_points = number_after(printed, "curves' time: ", 1);
+    c.curves = number_after(printed, "\ncurves (", 0);
+    c.codim2 = number_after(printed, "codimension-two points (", 0);
     if (std::isnan(c.codim2)) c.codim2 = 0.0;
     for (const double read : {c.branch_seconds, c.branch_points, c.curves_seconds, c.curve_points,
                               c.curves}) {
@@ -85,7 +101,7 @@ void run(const CurvesBenchOptions& o) {
         fmt::format("{} run {} --set output.out={}{}", shell_quoted(self),
                     shell_quoted(map_scene), shell_quoted(work + "/map"), map_sets));
     map_walls.push_back(seconds_since(map_start));
-    cells = number_after(map_printed, R"(map\.csv \(([0-9]+) cells\))");
+    cells = number_after(map_printed, "map.csv (", 0);
     if (std::isnan(cells)) {
       throw Error(fmt::format("bench curves: the run of {} did not print its cells:\n{}",
                               map_scene, map_printed));
