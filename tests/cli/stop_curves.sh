@@ -11,12 +11,7 @@ args="continue --figure 5 --parameter theta --range 0.5:3 --curves alpha=1:15 --
       --quiet --no-plot"
 rm -rf "$out"
 mkdir -p "$out"
-if env --default-signal=INT true 2> /dev/null; then
-  launch="env --default-signal=INT"
-else
-  echo "SKIP: this env cannot start a command with SIGINT at its default (coreutils < 8.31)"
-  exit 77
-fi
+. "$(dirname "$0")/signal_launch.sh"  # sets $launch (SIGINT at its default)
 for signal in INT TERM; do
   folder="$out/stopped_$signal"
   $launch "$pwl" $args --out "$folder" > /dev/null 2> "$out/$signal.err" &

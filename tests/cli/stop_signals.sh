@@ -16,14 +16,7 @@ args="sweep --figure 5 --parameter theta --range 0.8:2.6 --points 6 --mode conti
 total=12
 rm -rf "$out"
 mkdir -p "$out"
-# A command started with & by a non-interactive shell ignores SIGINT, and pwl leaves an ignored
-# signal ignored: start it with SIGINT at its default.
-if env --default-signal=INT true 2> /dev/null; then
-  launch="env --default-signal=INT"
-else
-  echo "SKIP: this env cannot start a command with SIGINT at its default (coreutils < 8.31)"
-  exit 77
-fi
+. "$(dirname "$0")/signal_launch.sh"  # sets $launch (SIGINT at its default)
 now_ms() { echo $(($(date +%s%N) / 1000000)); }
 begin=$(now_ms)
 "$pwl" $args --out "$out/whole" > /dev/null || { echo "the uninterrupted run failed"; exit 1; }
