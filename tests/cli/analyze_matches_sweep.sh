@@ -1,7 +1,8 @@
 #!/bin/sh
 # pwl analyze and a one-point pwl sweep of the same case and record length print and write the
 # same regime, period, λ1 (with its error) and K, digit for digit, because both run the one study
-# pipeline; and the one-point sweep draws its bifurcation diagram.
+# pipeline, evidence ladder included (its minimal period, multiplier, the method the verdict rests
+# on and the periods it was seen over); and the one-point sweep draws its bifurcation diagram.
 # Usage: analyze_matches_sweep.sh PWL OUTPUT_FOLDER FIGURE THETA TRANSIENT RECORDED
 #                                 "ANALYZE FLAGS" "SWEEP FLAGS"
 set -u
@@ -43,7 +44,19 @@ check() {
 check regime "$printed_regime" "$regime"
 check "printed lambda1" "$printed_lambda" "$(printf '%.5f %.1e' "$lambda1" "$lambda1_error")"
 check "printed K" "$printed_k" "$(printf '%.3f' "$k")"
-check "classification.csv" "$written" \
+check "classification.csv" "$(echo "$written" | cut -d, -f1-5)" \
   "$(printf '%s,%s,%.10g,%.3g,%.6g' "$regime" "$period" "$lambda1" "$lambda1_error" "$k")"
+# The ladder's columns, by name in each file's header.
+column() {  # FILE NAME: the last row's cell under NAME
+  awk -F, -v name="$2" 'NR == 1 { for (i = 1; i <= NF; ++i) if ($i == name) c = i }
+                        END { if (c) print $c; else print "(no column " name ")" }' "$1"
+}
+for name in minimal_period record_period decided_by confirmation observed_periods halves rotation_pq; do
+  check "$name" "$(column "$out/analyze/classification.csv" "$name")" \
+    "$(column "$out/sweep/classification.csv" "$name")"
+done
+multiplier=$(column "$out/sweep/classification.csv" multiplier)
+[ -n "$multiplier" ] && multiplier=$(printf '%.10g' "$multiplier")
+check multiplier "$(column "$out/analyze/classification.csv" multiplier)" "$multiplier"
 [ "$fail" -eq 0 ] || exit 1
-echo "analyze and the one-point sweep agree: $regime, period $period, lambda1 $lambda1 ± $lambda1_error, K $k"
+echo "analyze and the one-point sweep agree: $regime, period $period, lambda1 $lambda1 ± $lambda1_error, K $k, minimal period $(column "$out/sweep/classification.csv" minimal_period), decided by $(column "$out/sweep/classification.csv" decided_by)"

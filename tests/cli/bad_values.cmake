@@ -25,11 +25,12 @@ set_tests_properties(cli_analyze_undamped_resonance_unbounded PROPERTIES
                      ENVIRONMENT "PWL_PLOTS_DIR=${PROJECT_SOURCE_DIR}/plots")
 # Detuned (θ = 0.97), the same mass beats with a bounded envelope: not unbounded. The beat is
 # exactly periodic: 97 forcing periods are 100 free periods, beyond the period search's 64, and
-# orbit refinement finds the motion on a period-97 orbit (neutral: |μ| = 1, no damping).
+# orbit refinement (the evidence ladder) finds the motion on a period-97 orbit (neutral: |μ| = 1,
+# no damping).
 add_test(NAME cli_analyze_undamped_beating_bounded
          COMMAND pwl analyze --n 1 --alpha 0 --zeta 0 --theta 0.97 --loads 1
                  --out ${PWL_CLI_OUT}/undamped_beating)
 set_tests_properties(cli_analyze_undamped_beating_bounded PROPERTIES
-                     PASS_REGULAR_EXPRESSION "regime: quasi-periodic.*orbit refinement: period-97, not attracting [^\n]*: the motion is on it"
+                     PASS_REGULAR_EXPRESSION "regime: period-97.*Newton: minimal period 97, leading [^\n]* = 1 at that period; the motion is on it"
                      FAIL_REGULAR_EXPRESSION "pwl: |unbounded"
                      ENVIRONMENT "PWL_PLOTS_DIR=${PROJECT_SOURCE_DIR}/plots")

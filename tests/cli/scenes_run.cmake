@@ -22,8 +22,8 @@ set(small
   "paper_fig6.toml|run.periods=400 analysis.transient=250"
   "paper_fig7-9_table1.toml|structure.masses=200 method.reference_tol=1e-10 run.runs=1 run.t_end=20"
   "theta_alpha_curves.toml|continuation.range=0.98:1.02 continuation.curves=alpha=4.5:5.5 run.transient=50 output.no_plot=true"
-  "theta_alpha_map.toml|map.x_points=5 map.y_points=4 run.transient=50 run.periods=100 run.evidence_periods=0 run.refine_orbits=0"
-  "theta_sweep.toml|sweep.points=12 run.transient=50 run.periods=100 run.evidence_periods=0 run.refine_orbits=0"
+  "theta_alpha_map.toml|map.x_points=5 map.y_points=4 run.transient=50 run.periods=100 run.quick=true"
+  "theta_sweep.toml|sweep.points=12 run.transient=50 run.periods=100 run.quick=true"
   "two_mass_stop.toml|"
   "two_mass_stop_gap_sweep.toml|sweep.points=6 run.transient=50 run.periods=60")
 file(GLOB scenes RELATIVE ${SOURCE_DIR}/apps/scenes ${SOURCE_DIR}/apps/scenes/*.toml)

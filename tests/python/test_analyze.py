@@ -36,10 +36,16 @@ def test_verdict_and_evidence_equal_the_cli(cli, flags, args):
     assert (a.period_search["best_k"], a.period_search["distinct_points"]) == (
         int(search.group(1)), int(search.group(2)))
     points = read_csv(out / "poincare.csv")
-    assert a.poincare.shape == (a.recorded, 10)
+    # The record, and the periods adaptive evidence added to it.
+    recorded = a.recorded + a.extra_periods
+    assert a.poincare.shape == (recorded, 10)
     assert largest_difference(a.poincare, state_matrix(points, STATE)) <= 1e-12
     assert largest_difference(a.t, points["t"]) <= 1e-12
-    assert np.array_equal(a.period_index, np.arange(a.transient + 1, a.transient + a.recorded + 1))
+    assert np.array_equal(a.period_index, np.arange(a.transient + 1, a.transient + recorded + 1))
+    # The evidence ladder's columns of classification.csv.
+    assert a.minimal_period == table["minimal_period"][0]
+    assert a.observed_periods == table["observed_periods"][0]
+    assert a.decided_by == table["decided_by"][0]
 
 
 def test_bad_values_raise_input_error_with_the_cli_message(cli):
@@ -52,3 +58,20 @@ def test_bad_values_raise_input_error_with_the_cli_message(cli):
         assert str(raised.value) in cli.error("analyze", *args, "--out", cli.folder / "bad")
     with pytest.raises(TypeError, match="unexpected keyword argument 'masses'"):
         pwl.analyze(masses=3)
+
+
+def test_the_ladder_gives_the_minimal_period_and_the_method_it_rests_on():
+    # Seven turns of a slow spiral onto the period-1 orbit, which the record's search takes for a
+    # period-7 cycle: Newton says period 1, the exact solver's Newton confirms it (pwl orbit
+    # --figure 5 --alpha 4.7 --theta 1.83 --period 1 --method exact: |mu| = 0.9866872283).
+    a = pwl.analyze(figure="5", alpha=4.7, theta=1.83)
+    assert (a.regime, a.period, a.minimal_period, a.record_period) == ("period-1", 1, 1, 7)
+    assert (a.decided_by, a.confirmed_by, a.confirmation) == ("exact", "exact", "newton")
+    assert a.multiplier == pytest.approx(0.9866872283, rel=1e-8)
+    assert a.observed_periods == a.recorded + a.extra_periods
+    assert a.seconds > 0
+    assert "decided by exact" in repr(a)
+    # The plain record: the spiral is still drifting after 500 periods, and nothing checks it.
+    q = pwl.analyze(figure="5", alpha=4.7, theta=1.83, quick=True)
+    assert q.regime == "uncertain" and q.minimal_period == 0 and q.decided_by == "pim"
+    assert q.extra_periods == 0 and q.confirmed_by == ""

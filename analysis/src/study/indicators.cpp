@@ -27,6 +27,14 @@ template <int PointResult::*kField>
 void set_integer(PointResult& r, const IndicatorValue& v) {
   r.*kField = static_cast<int>(std::get<long>(v));
 }
+template <std::string PointResult::*kField>
+IndicatorValue get_text(const PointResult& r) {
+  return r.*kField;
+}
+template <std::string PointResult::*kField>
+void set_text(PointResult& r, const IndicatorValue& v) {
+  r.*kField = std::get<std::string>(v);
+}
 IndicatorValue get_regime(const PointResult& r) { return r.regime; }
 void set_regime(PointResult& r, const IndicatorValue& v) { r.regime = std::get<std::string>(v); }
 IndicatorValue get_confirmed_by(const PointResult& r) { return r.confirmed_by; }
@@ -42,7 +50,7 @@ IndicatorValue get_code(const PointResult& r) {
 }
 
 // The table. Append new rows at the end: the result files' existing columns keep their places.
-constexpr std::array<Indicator, 14> kIndicators{{
+constexpr std::array<Indicator, 22> kIndicators{{
     {"regime", "the classified motion: period-k, quasi-periodic, chaotic, unbounded, uncertain",
      IndicatorType::text, false, "failed", get_regime, set_regime},
     {"code", "the regime as a small integer for colour maps (regime_code)", IndicatorType::integer,
@@ -92,6 +100,41 @@ constexpr std::array<Indicator, 14> kIndicators{{
      "for an uncertain point, what each indicator read (period, lambda1, K, torus; or a period "
      "Newton did not confirm), one token; empty otherwise",
      IndicatorType::text, false, "", get_disagreement, set_disagreement},
+    {"minimal_period",
+     "Newton's check of a period verdict: the orbit's minimal period (the smallest m dividing the "
+     "period found whose map closes it); 0 when no Newton checked the period",
+     IndicatorType::integer, false, "", get_integer<&PointResult::minimal_period>,
+     set_integer<&PointResult::minimal_period>},
+    {"multiplier",
+     "the largest modulus of the checked orbit's Floquet multipliers at its minimal period",
+     IndicatorType::real, false, "", get_real<&PointResult::multiplier>,
+     set_real<&PointResult::multiplier>},
+    {"record_period",
+     "the period the record's own search found (0: none), before Newton reduced or refinement "
+     "found it",
+     IndicatorType::integer, false, "", get_integer<&PointResult::record_period>,
+     set_integer<&PointResult::record_period>},
+    {"decided_by", "the method the verdict rests on: the point's own or the one that confirmed it",
+     IndicatorType::text, false, "", get_text<&PointResult::decided_by>,
+     set_text<&PointResult::decided_by>},
+    {"confirmation",
+     "how the accurate method checked the verdict: newton (its orbit at that period) or motion "
+     "(its own run from the same start); empty when not checked",
+     IndicatorType::text, false, "", get_text<&PointResult::confirmation>,
+     set_text<&PointResult::confirmation>},
+    {"observed_periods",
+     "forcing periods the verdict's indicators were measured over (record and adaptive evidence)",
+     IndicatorType::integer, false, "", get_integer<&PointResult::observed_periods>,
+     set_integer<&PointResult::observed_periods>},
+    {"halves",
+     "chaotic or quasi-periodic verdict: agree when lambda1, K and the torus test read the same "
+     "over both halves of the record, else differ: and the indicators that changed",
+     IndicatorType::text, false, "", get_text<&PointResult::halves>,
+     set_text<&PointResult::halves>},
+    {"rotation_pq",
+     "a period above 8 or an orbit locked on a torus: its rotation as p/q, q the period",
+     IndicatorType::text, false, "", get_text<&PointResult::rotation_pq>,
+     set_text<&PointResult::rotation_pq>},
 }};
 
 std::string cell(const Indicator& indicator, const PointResult& r) {

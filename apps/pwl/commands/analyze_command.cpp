@@ -11,6 +11,7 @@
 
 #include <fmt/format.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -23,7 +24,6 @@
 #include "output/csv_writer.hpp"
 #include "output/gnuplot.hpp"
 #include "pwl/errors.hpp"
-#include "pwl/orbits/orbit_refinement.hpp"
 
 namespace pwl::app {
 namespace {
@@ -45,7 +45,8 @@ class AnalyzeFiles : public analysis::PointObserver {
         std::vector<std::string>{"t", fmt::format("x{}", mass_), fmt::format("v{}", mass_)});
   }
   StepObserver steps_of_period(int k) override {
-    if (k <= drawn_from_) return {};
+    // The last 20 periods of the record as set; adaptive evidence records more, not drawn.
+    if (k <= drawn_from_ || k > drawn_from_ + 20) return {};
     return [this](double t, const Vector& x, const Vector& v) {
       trajectory_->row({t, x[mass_ - 1], v[mass_ - 1]});
     };
@@ -87,10 +88,17 @@ class AnalyzeCollector : public analysis::PointObserver {
     result_.classification = c;
     if (also_ != nullptr) also_->classified(c, r);
   }
+  void stage_finished(std::string_view stage) override {
+    const auto now = std::chrono::steady_clock::now();
+    result_.stage_seconds.emplace_back(std::string(stage),
+                                       std::chrono::duration<double>(now - last_).count());
+    last_ = now;
+  }
 
  private:
   AnalyzeResult& result_;
   analysis::PointObserver* also_;
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
 };
 
 std::string estimate_description(analysis::LyapunovEstimate estimate, const std::string& label) {
@@ -143,6 +151,7 @@ AnalyzeResult analyze_case(const AnalyzeOptions& o, analysis::PointObserver* als
     }
   }
   s.section = o.section.poincare_section(n);
+  o.ladder.apply(s);
   const Vector start = o.run.start.state(n);
 
   AnalyzeResult a;
@@ -150,10 +159,69 @@ AnalyzeResult analyze_case(const AnalyzeOptions& o, analysis::PointObserver* als
   a.dofs = n;
   a.mass = mass;
   a.period = period;
+  const auto begin = std::chrono::steady_clock::now();
   AnalyzeCollector collector(a, also);
   a.result = analysis::evaluate_point(analysis::PointCase(structure, period), start, s, &collector);
+  a.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   return a;
 }
+
+namespace {
+
+// The ladder's steps beyond the record: Newton's check of the period, the accurate method's
+// confirmation, what the verdict was seen over, and what each stage cost.
+void print_ladder(const AnalyzeResult& a) {
+  const analysis::PointResult& r = a.result;
+  if (r.minimal_period > 0 && std::isfinite(r.multiplier)) {
+    std::string where = "the motion is on it";
+    if (std::isfinite(r.settle_periods) && r.settle_periods > 0.0) {
+      where = fmt::format("the motion approaches it, about {:.0f} more periods to reach it",
+                          std::ceil(r.settle_periods));
+    }
+    fmt::print("  Newton: minimal period {}{}, leading |μ| = {:.6g} at that period; {}\n",
+               r.minimal_period,
+               r.record_period > 0 && r.record_period != r.minimal_period
+                   ? fmt::format(" (the record's search said {})", r.record_period)
+                   : std::string(),
+               r.multiplier, where);
+  } else if (r.disagreement.find("newton:not-confirmed") != std::string::npos) {
+    fmt::print("  Newton: the record's period is not confirmed ({})\n", r.disagreement);
+  }
+  if ((r.regime == "quasi-periodic" || r.regime == "uncertain") && a.settings.refine_max_period > 0 &&
+      a.dofs > analysis::PointSettings::kRefinedMasses) {
+    fmt::print("  orbit refinement: not run for n = {} > {} masses (`pwl orbit --period K` finds "
+               "an orbit of a given period)\n",
+               a.dofs, analysis::PointSettings::kRefinedMasses);
+  }
+  if (!r.confirmed_by.empty()) {
+    fmt::print("  confirmed by the {} method ({}); the verdict rests on {}\n", r.confirmed_by,
+               r.confirmation == "newton" ? "Newton on its map at the same period"
+                                          : "its own motion from the same start",
+               r.decided_by);
+  } else if (!r.decided_by.empty()) {
+    fmt::print("  the verdict rests on {}\n", r.decided_by);
+  }
+  if (r.observed_periods > 0) {
+    fmt::print("  seen over {} periods{}{}{}\n", r.observed_periods,
+               r.extra_periods > 0 ? fmt::format(" ({} of them adaptive evidence)", r.extra_periods)
+                                   : std::string(),
+               r.halves.empty() ? std::string()
+                                : fmt::format("; the two halves of the record: {}", r.halves),
+               r.rotation_pq.empty() ? std::string()
+                                     : fmt::format("; rotation {}", r.rotation_pq));
+  }
+  if (!a.stage_seconds.empty()) {
+    std::string stages;
+    for (const auto& [stage, seconds] : a.stage_seconds) {
+      if (seconds < 0.0005) continue;
+      stages += fmt::format("{}{} {:.3g} s", stages.empty() ? "" : ", ", stage, seconds);
+    }
+    fmt::print("  cost: {:.3g} s ({}){}\n", a.seconds, stages,
+               a.settings.ladder_on() ? "" : "; --quick: the plain record");
+  }
+}
+
+}  // namespace
 
 void analyze(const AnalyzeOptions& o) {
   AnalyzeResult a;
@@ -199,7 +267,10 @@ void analyze(const AnalyzeOptions& o) {
   }
   fmt::print("  lambda1: {:.5f} ± {:.1e} per period, {:.5f} per unit time ({})\n", result.lambda1,
              result.lambda1_error, result.lambda1 / period,
-             estimate_description(s.lyapunov_estimate, std::string(method.label)));
+             estimate_description(s.lyapunov_estimate,
+                                  result.confirmation == "motion"
+                                      ? std::string(method_traits(parse_method(result.decided_by)).label)
+                                      : std::string(method.label)));
   fmt::print("  0-1 test: K = {:.3f}\n", result.K);
   if (std::isfinite(result.torus_digits)) {
     fmt::print("  torus test: {:.2f} digits (weighted Birkhoff averages of the record's halves; a "
@@ -216,36 +287,20 @@ void analyze(const AnalyzeOptions& o) {
                "time λ1 > 0 along them), then settled on its period-{} orbit\n",
                result.chaotic_transient, result.period);
   }
-  // Orbit refinement (orbit_refinement.hpp) when the record is called quasi-periodic or uncertain,
-  // which a slow approach to a periodic orbit can look like: the periodic orbit the motion is on
-  // or approaching, if Newton finds one from the motion's last state (at phase 0: a whole number
-  // of periods after the record), with the rate of the approach. Evidence printed beside the
-  // regime, which it does not change yet.
-  // Up to 20 masses: Newton carries 2n tangent columns through candidate periods of up to 300
-  // forcing periods (about 1.5 s for 5 masses by the exact solver); the cost grows like n² per
-  // period, so that beyond, `pwl orbit --period K` asks for one period instead.
-  constexpr Index kRefinementMasses = 20;
-  const bool refinable = c && (result.regime == "uncertain" || result.regime == "quasi-periodic") &&
-                         s.section.stroboscopic() && result.final_state.size() == 2 * n;
-  if (refinable && n > kRefinementMasses) {
-    fmt::print("  orbit refinement: not run for n = {} > {} masses (`pwl orbit --period K` finds "
-               "an orbit of a given period)\n",
-               n, kRefinementMasses);
-  }
-  if (refinable && n <= kRefinementMasses) {
-    std::vector<Vector> points;
-    for (std::size_t i = 0; (i + 1) * static_cast<std::size_t>(2 * n) <= a.section_states.size();
-         ++i) {
-      points.push_back(Eigen::Map<const Vector>(a.section_states.data() + i * 2 * n, 2 * n));
-    }
-    orbits::StroboscopicMap map(analysis::PointCase(o.run.structure(), period), s.method,
-                                s.steps_per_period);
-    const orbits::OrbitRefinement refined = orbits::refine_orbit(map, points, result.final_state);
-    fmt::print("  orbit refinement: {}\n", refined.describe());
-  }
+  print_ladder(a);
   if (std::FILE* f = std::fopen((o.out + "/classification.csv").c_str(), "w")) {
-    fmt::print(f, "regime,period,lambda1_per_period,lambda1_error,K\n{},{},{:.10g},{:.3g},{:.6g}\n",
-               result.regime, c ? c->period : 0, result.lambda1, result.lambda1_error, result.K);
+    // The record's five columns, then the ladder's (sweep_point.hpp says what each is).
+    const auto real = [](double x) { return std::isnan(x) ? std::string() : fmt::format("{:.10g}", x); };
+    fmt::print(f,
+               "regime,period,lambda1_per_period,lambda1_error,K,minimal_period,multiplier,"
+               "settle_periods,record_period,decided_by,confirmation,observed_periods,halves,"
+               "rotation_pq,chaotic_transient\n"
+               "{},{},{:.10g},{:.3g},{:.6g},{},{},{},{},{},{},{},{},{},{}\n",
+               result.regime, result.period, result.lambda1, result.lambda1_error, result.K,
+               result.minimal_period, real(result.multiplier), real(result.settle_periods),
+               result.record_period, result.decided_by, result.confirmation,
+               result.observed_periods, result.halves, result.rotation_pq,
+               result.chaotic_transient);
     std::fclose(f);
   }
   std::string why;
@@ -291,6 +346,7 @@ void add_analyze_flags(CLI::App& c, AnalyzeOptions& options) {
                "(default, as pwl sweep and map: tangent-vector when the method has an exact\n"
                "tangent map, else two-trajectories)")
       ->check(CLI::IsMember({"tangent-vector", "tangent-frame", "two-trajectories"}));
+  add_ladder_flags(c, options.ladder);
   c.add_option("--out", options.out, "Output folder");
 }
 

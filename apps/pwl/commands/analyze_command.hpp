@@ -17,9 +17,11 @@
 #include <CLI/CLI.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "commands/case_options.hpp"
+#include "commands/ladder_flags.hpp"
 #include "pwl/analysis/motion_classifier.hpp"
 #include "pwl/study/sweep_point.hpp"
 
@@ -34,6 +36,7 @@ struct AnalyzeOptions {
   // How λ1 is estimated; empty: one tangent vector when the method has an exact tangent map,
   // else two nearby trajectories.
   std::string lyapunov;
+  LadderFlags ladder;    // the evidence ladder (on unless --quick), as sweep and map
   std::string out = "out";
 };
 
@@ -58,6 +61,10 @@ struct AnalyzeResult {
   std::vector<double> section_times;
   std::vector<int> section_periods;
   std::vector<double> section_states;
+  // What the evaluation cost, in wall seconds: each stage of the ladder in order (record, newton,
+  // observation, confirmation, attractors) and the whole. Printed, never part of a result file.
+  std::vector<std::pair<std::string, double>> stage_seconds;
+  double seconds = 0.0;
 };
 
 // Checks the flags (InputError naming the flag: --mass out of range, fewer than 100 recorded

@@ -90,9 +90,7 @@ analysis::PointSettings PointFlags::settings(int masses) const {
   s.method.tolerance = tolerance;
   s.method.locate_kinks = locate_kinks;
   s.method.lcp = parse_lcp_algorithm(lcp_solver);
-  s.refine_max_period = refine_orbits;
-  s.evidence_periods = evidence_periods;
-  s.confirm = analysis::parse_confirmation(confirm);
+  ladder.apply(s);
   s.starts = starts;
   for (const std::string& name : record) s.components.push_back(parse_component("--record", name, masses));
   if (record.empty()) s.components = {masses - 1, 2 * masses - 1};
@@ -124,22 +122,7 @@ void add_point_flags(CLI::App& c, PointFlags& f, bool with_record) {
              "dopri5/rkf78: end a step exactly at every spring opening or closing");
   c.add_option("--lcp", f.lcp_solver, "PIM's LCP solver: block-pivoting or lemke")
       ->check(CLI::IsMember({"block-pivoting", "lemke"}));
-  c.add_option("--refine-orbits", f.refine_orbits,
-               "Orbit refinement of quasi-periodic and uncertain points (up to 20 masses): Newton\n"
-               "on the stroboscopic map at candidate periods up to this many forcing periods; a\n"
-               "periodic orbit the motion is on or is confirmed to approach makes the point\n"
-               "period-k (settle_periods: the periods it still needs). 0: off (default)")
-      ->check(number_in(0, 1000));
-  c.add_option("--evidence-periods", f.evidence_periods,
-               "Adaptive evidence: an uncertain point records longer, doubling its record, until\n"
-               "its indicators agree or this many more periods are spent (extra_periods). 0: off\n"
-               "(default)")
-      ->check(non_negative_number());
-  c.add_option("--confirm", f.confirm,
-               "Verdicts of an approximate method (the PIM) the exact event-driven solver checks by\n"
-               "running the point again (up to 20 masses): none (default), uncertain, or aperiodic\n"
-               "(uncertain, chaotic and quasi-periodic); confirmed_by says which did")
-      ->check(CLI::IsMember({"none", "uncertain", "aperiodic"}));
+  add_ladder_flags(c, f.ladder);
   c.add_option("--starts", f.starts,
                "Coexisting attractors: start each point from this many initial states (its own and\n"
                "reproducible random ones about its motion) and count the distinct attractors they\n"
@@ -197,7 +180,7 @@ std::string first_difference(const std::string& recorded, const std::string& now
 // The format of the journals (sweep_journal.hpp), recorded in config.txt after the study's
 // description. A folder whose config.txt lacks it holds journals whose checksums leave the ids
 // out, which this version does not read.
-constexpr std::string_view kJournalFormat = "journal_format = 4\n";
+constexpr std::string_view kJournalFormat = "journal_format = 5\n";
 
 std::vector<fs::path> journal_files(const fs::path& folder) {
   std::vector<fs::path> files;
@@ -287,6 +270,21 @@ void run_distributed(const Study& study, const RunFlags& flags, const Distribute
           "--resume into {}: its journals are of an older format, whose checksums leave the point "
           "ids out (config.txt has no \"{}\"); start over without --resume",
           flags.out, kJournalFormat.substr(0, kJournalFormat.size() - 1)));
+    }
+    // A journal of another format: its lines hold another set of indicators (format 5 added the
+    // ladder's: minimal period, multiplier, record period, decided by, confirmation, observed
+    // periods, halves, rotation p/q).
+    const std::size_t format_at = recorded.rfind("journal_format = ");
+    const std::string_view expected = kJournalFormat.substr(0, kJournalFormat.size() - 1);
+    if (format_at != std::string::npos) {
+      std::string format = recorded.substr(format_at);
+      format = format.substr(0, format.find('\n'));
+      if (format != expected) {
+        throw InputError(fmt::format(
+            "--resume into {}: its journals are of an older format (config.txt has \"{}\", this "
+            "version writes \"{}\", with more indicators per point); start over without --resume",
+            flags.out, format, expected));
+      }
     }
     if (recorded != configuration) {
       throw InputError(fmt::format("--resume into {}: its configuration differs: {}", flags.out,
@@ -541,14 +539,27 @@ std::string study_title(const analysis::PointModel& model, const analysis::Point
   if (!point.section.is_default()) {
     title += fmt::format("; section {}", point.section.label(model.dofs()));
   }
-  // The verdict's helpers, briefly (analysis/README.md, "How a verdict is reached", says what each does).
-  if (point.evidence_periods > 0) title += fmt::format("; evidence +{}", point.evidence_periods);
-  if (point.confirm != analysis::Confirmation::none) {
-    title += point.confirm == analysis::Confirmation::uncertain ? ", exact check"
-                                                                : ", exact check (aperiodic)";
-  }
-  if (point.refine_max_period > 0) {
-    title += fmt::format(", refinement <= {}", point.refine_max_period);
+  // The evidence ladder, briefly (analysis/README.md, "How a verdict is reached", says what each
+  // step does): named as a whole when it is the default, else step by step.
+  analysis::PointSettings ladder = point;
+  ladder.use_ladder();
+  const bool default_ladder = ladder.evidence_periods == point.evidence_periods &&
+                              ladder.refine_max_period == point.refine_max_period &&
+                              ladder.check_periods == point.check_periods &&
+                              ladder.confirm == point.confirm;
+  if (default_ladder) {
+    title += "; evidence ladder";
+  } else if (!point.ladder_on()) {
+    title += "; plain record (--quick)";
+  } else {
+    if (point.evidence_periods > 0) title += fmt::format("; evidence +{}", point.evidence_periods);
+    if (point.refine_max_period > 0) {
+      title += fmt::format(", refinement <= {}", point.refine_max_period);
+    }
+    if (point.check_periods) title += ", periods by Newton";
+    if (point.confirm != analysis::Confirmation::none) {
+      title += fmt::format(", checked ({})", analysis::confirmation_name(point.confirm));
+    }
   }
   title.erase(std::remove(title.begin(), title.end(), '\''), title.end());
   return title;

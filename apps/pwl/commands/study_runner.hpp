@@ -30,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "commands/ladder_flags.hpp"
 #include "pwl/study/parameter_grid.hpp"
 #include "pwl/study/sweep_point.hpp"
 
@@ -68,9 +69,9 @@ struct PointFlags {
   double tolerance = 1e-10;
   bool locate_kinks = false;
   std::string lcp_solver = "block-pivoting";
-  int refine_orbits = 0;  // longest candidate period of orbit refinement; 0: none
-  int evidence_periods = 0;  // adaptive evidence budget; 0: none
-  std::string confirm = "none";  // verdicts the exact solver checks: none, uncertain, aperiodic
+  // The evidence ladder (PointSettings::use_ladder) is on unless `quick`; each of its flags given
+  // explicitly wins over both (-1 and empty: not given).
+  LadderFlags ladder;
   int starts = 1;  // initial states per point, for counting coexisting attractors
   // Throws InputError for a bad name or value.
   analysis::PointSettings settings(int dofs) const;

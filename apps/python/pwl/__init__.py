@@ -116,11 +116,17 @@ class AnalyzeResult(_Result):
         without the time), their times and periods
     final_state: [x; v] after the record; lyapunov: how lambda1 was estimated
     transient, recorded, mass, dofs, forcing_period, integrator, method, section, description
+    The evidence ladder's steps (on unless quick=True), as the columns of pwl sweep and map:
+    minimal_period, multiplier, settle_periods and record_period (Newton's check of a period),
+    decided_by, confirmed_by and confirmation (the method the verdict rests on and how it was
+    checked), observed_periods, extra_periods, halves and rotation_pq (what it was seen over),
+    torus_digits, rotation, chaotic_transient, disagreement; seconds: what the evaluation cost
     """
 
     def _summary(self):
-        return "{}, lambda1 = {:.4g} +- {:.2g}, K = {:.3g}; {} by {}".format(
-            self.regime, self.lambda1, self.lambda1_error, self.K, self.description, self.method)
+        return "{}, lambda1 = {:.4g} +- {:.2g}, K = {:.3g}; {} by {}, decided by {}".format(
+            self.regime, self.lambda1, self.lambda1_error, self.K, self.description, self.method,
+            self.decided_by)
 
 
 class SweepResult(_Result):

@@ -231,7 +231,7 @@ py::dict analyze(py::kwargs kwargs) {
   py::dict d;
   d["regime"] = r.regime;
   d["code"] = analysis::regime_code(r.regime, r.period);
-  d["period"] = a.classification ? a.classification->period : 0;
+  d["period"] = r.period;
   d["lambda1"] = r.lambda1;
   d["lambda1_error"] = r.lambda1_error;
   d["K"] = r.K;
@@ -263,6 +263,20 @@ py::dict analyze(py::kwargs kwargs) {
   d["method"] = std::string(method_traits(a.settings.method.method).name);
   d["section"] = a.settings.section.label(n);
   d["description"] = name_given_structure(options.run.description(), file.get());
+  // Every other indicator of the pipeline (the evidence ladder's), as sweep and map give them.
+  for (const analysis::Indicator& indicator : analysis::indicators()) {
+    const std::string name(indicator.name);
+    if (d.contains(name)) continue;
+    const analysis::IndicatorValue v = indicator.get(r);
+    if (const auto* text = std::get_if<std::string>(&v)) {
+      d[name.c_str()] = *text;
+    } else if (const auto* integer = std::get_if<long>(&v)) {
+      d[name.c_str()] = *integer;
+    } else {
+      d[name.c_str()] = std::get<double>(v);
+    }
+  }
+  d["seconds"] = a.seconds;
   return d;
 }
 

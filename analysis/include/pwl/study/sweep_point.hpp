@@ -25,6 +25,7 @@
 // distributed and a resumed study write identical files.
 #include <limits>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "pwl/analysis/motion_classifier.hpp"
@@ -66,8 +67,14 @@ enum class Confirmation {
   none,       // the method's verdict stands
   uncertain,  // a point still uncertain (after adaptive evidence and refinement) is run again
   aperiodic,  // so are chaotic and quasi-periodic points
+  // A period verdict is checked by Newton on the accurate method's map at that period (its
+  // motion from the same start where Newton fails or finds another orbit), and uncertain and
+  // quasi-periodic points are run again: every regular verdict rests on the accurate method.
+  regular,
+  all,  // regular, and chaotic points are run again too
 };
-// "none", "uncertain", "aperiodic"; the inverse throws InputError naming the value.
+// "none", "uncertain", "aperiodic", "regular", "all"; the inverse throws InputError naming the
+// value.
 std::string confirmation_name(Confirmation confirmation);
 Confirmation parse_confirmation(const std::string& name);
 
@@ -112,6 +119,24 @@ struct PointSettings {
   // up to this many periods).
   int refine_max_period = 0;
   static constexpr int kRefinedMasses = 20;
+  // Every period verdict checked by Newton on the stroboscopic map at its period, from the
+  // motion's last state (dense up to 400 state components, Newton–Krylov beyond): the verdict
+  // becomes the orbit's minimal period (PointResult::minimal_period), with its leading multiplier
+  // and whether the motion is on it or approaching it (settle_periods); a period Newton does not
+  // confirm is "uncertain". Off: the record's period stands (as before this setting existed).
+  bool check_periods = false;
+  // The evidence ladder every job runs unless asked for the plain record (`--quick`): adaptive
+  // evidence up to kLadderEvidencePeriods more periods, refinement up to kLadderRefinePeriod,
+  // every period checked by Newton, and regular verdicts confirmed by the accurate method
+  // (Confirmation::regular). The library's defaults stay the plain record.
+  static constexpr int kLadderEvidencePeriods = 3500;
+  static constexpr int kLadderRefinePeriod = 150;
+  void use_ladder();
+  // Whether any step of the ladder is on.
+  bool ladder_on() const {
+    return evidence_periods > 0 || refine_max_period > 0 || check_periods ||
+           confirm != Confirmation::none;
+  }
   // How many of the recorded points are kept: 0 every one, N > 0 only the last N (the last N
   // periods of a stroboscopic section, the last N crossings of a hyperplane). All of them are
   // classified either way. A basin map matches attractors on a short tail of each cell's motion
@@ -153,8 +178,32 @@ struct PointResult {
   double settle_periods = std::numeric_limits<double>::quiet_NaN();
   // Adaptive evidence (PointSettings::evidence_periods): the periods recorded beyond the setting.
   int extra_periods = 0;
-  // "exact" when the exact solver's run decided the point (PointSettings::confirm), else empty.
+  // The accurate method that checked the verdict (PointSettings::confirm): "exact" or
+  // "pim-switching"; empty when none did.
   std::string confirmed_by;
+  // How it checked it: "newton" (its orbit at the verdict's period, which the motion is on or
+  // approaches) or "motion" (its own motion from the same start decided); empty when not checked.
+  std::string confirmation;
+  // The method the verdict rests on: the point's own, or the one that confirmed it.
+  std::string decided_by;
+  // Newton's check of a period verdict (check_periods, refinement, or confirmation): the orbit's
+  // minimal period (= period) and the largest modulus of its Floquet multipliers at that period;
+  // 0 and NaN when no Newton checked the period.
+  int minimal_period = 0;
+  double multiplier = std::numeric_limits<double>::quiet_NaN();
+  // The period the record's own search found (0: none); differs from `period` when Newton
+  // reduced it (seven turns of a slow spiral onto a period-1 orbit) or refinement found one.
+  int record_period = 0;
+  // The forcing periods the verdict's indicators were measured over (the record with its
+  // adaptive evidence, of the run that decided); 0 for a motion that blew up or failed.
+  int observed_periods = 0;
+  // A chaotic or quasi-periodic verdict: "agree" when λ1, K and the torus test read the same over
+  // both halves of the record as over the whole, else "differ:" and the indicators that changed
+  // ("differ:lambda1+K"); empty otherwise.
+  std::string halves;
+  // The rotation of a long period (above 8) or of an orbit locked on a torus as "p/q" (q its
+  // period); empty otherwise or when not measured.
+  std::string rotation_pq;
   // The torus test (weighted_birkhoff.hpp) of a record without a period: the digits on which the
   // weighted Birkhoff averages of its two halves agree (high on a smooth invariant curve, about 1
   // to 2 on chaos), and the rotation number in the plane of the first two state components, in
@@ -209,6 +258,10 @@ class PointObserver {
   // growth found by the classifier is classified, and "unbounded").
   virtual void classified(const Classification& /*classification*/,
                           const PointResult& /*result*/) {}
+  // After each stage of the ladder ("record", "newton", "observation", "confirmation",
+  // "attractors"; a confirming run by the accurate method reports none): for a caller that
+  // measures what each stage costs. Never changes the result.
+  virtual void stage_finished(std::string_view /*stage*/) {}
 };
 
 // Integrates `point` from `initial_state` ([x; v], 2n; the loads start at phase 0) over
@@ -219,8 +272,14 @@ class PointObserver {
 // that blows up is "unbounded" (not an exception), and so is one that grows without bound while
 // staying finite over the record, such as an undamped resonance: the classifier's secular-growth
 // rule (motion_classifier.hpp, rule 4a) measures the amplitude's power of t against the time since
-// the initial state; its final state is then left empty, as for a blow-up. Throws InputError for
-// invalid settings or state.
+// the initial state; its final state is then left empty, as for a blow-up. Then the evidence
+// ladder, as far as the settings ask (each step off by default here; PointSettings::use_ladder
+// turns all on, as every job does unless --quick): adaptive evidence, Newton's check of a period
+// and refinement of a record without one, transient chaos, what the verdict was seen over, the
+// confirmation by an accurate method, more starts (analysis/src/study/ladder/ has one file per
+// stage). The observer sees the first run's record; a confirming run by the accurate method is
+// not observed, but `classified` gets the classification of the run the verdict rests on. Throws
+// InputError for invalid settings or state.
 PointResult evaluate_point(const PointCase& point, const Vector& initial_state,
                            const PointSettings& settings, PointObserver* observer = nullptr);
 
