@@ -19,18 +19,7 @@
 using namespace pwl;
 using namespace pwl::analysis;
 
-namespace {
-
-PointSettings exact_record(int transient, int recorded) {
-  PointSettings s;
-  s.transient_periods = transient;
-  s.recorded_periods = recorded;
-  s.method = MethodSettings{Method::exact};
-  s.lyapunov_estimate = LyapunovEstimate::two_trajectories;
-  return s;
-}
-
-}  // namespace
+using pwl::test::exact_record;
 
 TEST_CASE("a chaotic verdict says how long it was seen and whether its halves agree",
           "[sweep_point][observation]") {

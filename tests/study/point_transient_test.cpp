@@ -32,14 +32,7 @@ namespace {
 
 PointCase chain(double alpha, double theta) { return PointCase(pwl::test::figure5_cell(alpha, theta)); }
 
-PointSettings exact_record(int transient, int recorded) {
-  PointSettings s;
-  s.transient_periods = transient;
-  s.recorded_periods = recorded;
-  s.method = MethodSettings{Method::exact};
-  s.lyapunov_estimate = LyapunovEstimate::two_trajectories;
-  return s;
-}
+using pwl::test::exact_record;
 
 double distance_to_orbit(const Vector& y, const std::vector<Vector>& orbit) {
   double d = std::numeric_limits<double>::infinity();

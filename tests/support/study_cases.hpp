@@ -1,6 +1,7 @@
 #pragma once
 // What the study-pipeline tests (tests/study) share: the paper's figure-5 chain at a cell of the
-// (θ, α) map, an observer that keeps the recorded stroboscopic states, and points as matrix rows.
+// (θ, α) map, a record by the exact solver, an observer that keeps the recorded stroboscopic
+// states, and points as matrix rows.
 #include <vector>
 
 #include "pwl/model/chain_builders.hpp"
@@ -16,6 +17,17 @@ inline NondimensionalChain figure5_cell(double alpha, double theta) {
   c.alpha = {alpha};
   c.theta = theta;
   return c;
+}
+
+// A record by the exact event-driven solver, λ1 by two nearby trajectories (it has no step to
+// take a tangent of), every step of the ladder off.
+inline analysis::PointSettings exact_record(int transient, int recorded) {
+  analysis::PointSettings s;
+  s.transient_periods = transient;
+  s.recorded_periods = recorded;
+  s.method = MethodSettings{Method::exact};
+  s.lyapunov_estimate = analysis::LyapunovEstimate::two_trajectories;
+  return s;
 }
 
 // Keeps every recorded stroboscopic state [x; v] of a point's evaluation.
