@@ -8,6 +8,8 @@
 //    whose multiplier near −1 (|μ| = 0.984) makes the exact motion look period-2 for a while.
 //    With the ladder's confirmation the verdict is period-1, decided by the exact solver; the
 //    exact motion integrated further settles on period 1 by the record's own search.
+//  - α = 10, θ = 1.9 with the PIM at a coarse T/18: the step makes the period-1 orbit stable; on the
+//    exact map it is unstable and the motion is a torus, which decides.
 //  - A verdict the exact map shares is confirmed by Newton alone (no second motion): figure 4a.
 //  - Beyond 20 masses the switching PIM is the accurate method; the exact solver never is.
 #include <catch2/catch.hpp>
@@ -72,6 +74,37 @@ TEST_CASE("a period the PIM's step makes is decided by the exact map", "[sweep_p
   // Truth 2: the exact motion, integrated 300 periods further, repeats every period.
   const PointResult later = evaluate_point(point, rest, record(1300, 200, Method::exact));
   CHECK(later.regime == "period-1");
+}
+
+TEST_CASE("a coarse PIM step that makes an unstable orbit stable is decided by the exact map",
+          "[sweep_point][confirmation]") {
+  // Figure 5's chain at α = 10, θ = 1.9 with the PIM at T/18 (η ω_max = 0.68: warned, accepted):
+  // the motion is on a period-1 orbit (|μ| = 0.944 on the PIM's map). The exact map has that orbit
+  // but unstable (a complex pair at |μ| = 1.06), and the exact motion is on a torus around it.
+  const PointCase point(pwl::test::figure5_cell(10.0, 1.9));
+  const Vector rest = Vector::Zero(10);
+  PointSettings s = record(500, 500);
+  s.steps_per_period = 18;
+  const PointResult pim = evaluate_point(point, rest, s);
+  REQUIRE(pim.regime == "period-1");
+
+  // Truth: Newton on the exact map from the PIM's state finds the period-1 orbit, unstable.
+  orbits::StroboscopicMap exact_map(point, MethodSettings{Method::exact}, 1);
+  const orbits::PeriodicOrbit exact_orbit = orbits::find_periodic_orbit(exact_map, pim.final_state);
+  CHECK(exact_orbit.period == 1);
+  CHECK_FALSE(exact_orbit.stable());
+  pwl::test::measured("exact period-1 orbit: largest |mu|", exact_orbit.multipliers.largest_modulus());
+
+  s.check_periods = true;
+  s.confirm = Confirmation::regular;
+  const PointResult confirmed = evaluate_point(point, rest, s);
+  CHECK(confirmed.regime == "quasi-periodic");
+  CHECK(confirmed.decided_by == "exact");
+  CHECK(confirmed.confirmation == "motion");
+  // And the exact motion from rest, recorded alone: no period, and the same verdict.
+  const PointResult exact = evaluate_point(point, rest, record(1000, 1000, Method::exact));
+  CHECK(exact.period == 0);
+  CHECK(exact.regime == "quasi-periodic");
 }
 
 TEST_CASE("a verdict the exact map shares is confirmed by Newton alone",
