@@ -8,8 +8,10 @@
 set -u
 pwl=$1
 out=$2
+# The plain record (--quick): this test is about the journal's faults, not the verdicts; the
+# evidence ladder's journaling is checked by the kill-and-resume and identical-runs tests.
 args="sweep --figure 5 --parameter theta --range 0.8:2.6 --points 20 --mode continuation
-      --transient 200 --periods 100 --threads 2 --quiet --no-plot"
+      --transient 200 --periods 100 --threads 2 --quiet --no-plot --quick"
 rm -rf "$out"
 mkdir -p "$out"
 "$pwl" $args --out "$out/whole" > /dev/null || { echo "the uninterrupted run failed"; exit 1; }

@@ -1,14 +1,16 @@
 #!/bin/sh
 # A sweep killed with SIGKILL part-way and resumed with --resume ends with the same files, byte for
 # byte, as a run that was never interrupted.
-# Usage: sweep_kill_resume.sh PWL OUTPUT_FOLDER [TRANSIENT PERIODS] (per point; 1000 and 200)
+# Usage: sweep_kill_resume.sh PWL OUTPUT_FOLDER [TRANSIENT PERIODS [FLAGS]] (per point; 1000 and
+# 200; FLAGS more flags of the sweep, such as --quick)
 set -u
 pwl=$1
 out=$2
 transient=${3:-1000}
 periods=${4:-200}
+flags=${5:-}
 args="sweep --figure 5 --parameter theta --range 0.8:2.6 --points 60 --mode continuation
-      --transient $transient --periods $periods --threads 1 --quiet --no-plot"
+      --transient $transient --periods $periods --threads 1 --quiet --no-plot $flags"
 rm -rf "$out"
 mkdir -p "$out"
 "$pwl" $args --out "$out/whole" > /dev/null || { echo "the uninterrupted run failed"; exit 1; }

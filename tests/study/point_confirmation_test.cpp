@@ -14,6 +14,7 @@
 //  - Beyond 20 masses the switching PIM is the accurate method; the exact solver never is.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <stdexcept>
 
 #include "orbit_cases.hpp"
 #include "study_cases.hpp"
@@ -158,4 +159,36 @@ TEST_CASE("the accurate method is the exact solver up to 20 masses, the switchin
                      }());
   CHECK(exact.confirmed_by.empty());
   CHECK(exact.decided_by == "exact");
+}
+
+TEST_CASE("a confirming run and the Newton stages pass the caller's checkpoints on",
+          "[sweep_point][confirmation]") {
+  // The case above whose exact motion decides: the PIM's record (1000 periods), Newton on both
+  // maps, and the exact run's own 1000 periods all reach the checkpoint, so that a study told to
+  // stop (parameter_grid.cpp throws from it) stops within a period of any stage.
+  struct Counter : PointObserver {
+    long periods = 0, checkpoints = 0, throw_at = -1;
+    StepObserver steps_of_period(int) override {
+      ++periods;
+      return {};
+    }
+    void checkpoint() override {
+      if (++checkpoints == throw_at) throw std::runtime_error("stop");
+    }
+  };
+  const PointCase point(pwl::test::figure5_cell(10.0, 1.9));
+  PointSettings s = record(500, 500);
+  s.steps_per_period = 18;
+  s.check_periods = true;
+  s.confirm = Confirmation::regular;
+  Counter counter;
+  const PointResult r = evaluate_point(point, Vector::Zero(10), s, &counter);
+  REQUIRE(r.confirmation == "motion");
+  CHECK(counter.periods == 1000);  // the caller's own files see the first record only
+  CHECK(counter.checkpoints > 2000);
+  // Thrown from inside the confirming run, the stop ends the evaluation.
+  Counter stopper;
+  stopper.throw_at = 1500;
+  CHECK_THROWS_WITH(evaluate_point(point, Vector::Zero(10), s, &stopper), "stop");
+  CHECK(stopper.checkpoints == 1500);
 }

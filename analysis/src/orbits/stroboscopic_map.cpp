@@ -43,6 +43,7 @@ Vector StroboscopicMap::integrate(const Vector& y, double t0, double t1, Matrix*
     return base_end_;
   }
   replay_ready_ = false;
+  if (checkpoint_) checkpoint_();
   // Plain integrations are recorded too, over the spans whose products a shooting method takes
   // (up to kReplayPeriods forcing periods); a long transient's record would only fill memory up
   // to the integrator's bound and be dropped.

@@ -12,14 +12,15 @@ namespace {
 // Thrown out of a point's evaluation when the grid stops; caught by the grid alone.
 struct Abandoned {};
 
-// Looks at the stop request before every forcing period of a point. It sees no step and changes
-// nothing in the evaluation: a point that is not abandoned comes out bit for bit as without it.
+// Looks at the stop request at every checkpoint of a point's ladder (before every forcing period
+// of its records, before every integration of its Newton stages, also in a confirming run by the
+// accurate method). It sees no step and changes nothing in the evaluation: a point that is not
+// abandoned comes out bit for bit as without it.
 class StopCheck : public PointObserver {
  public:
   explicit StopCheck(const std::function<bool()>& should_stop) : should_stop_(should_stop) {}
-  StepObserver steps_of_period(int /*k*/) override {
+  void checkpoint() override {
     if (should_stop_()) throw Abandoned{};
-    return {};
   }
 
  private:

@@ -88,6 +88,9 @@ class AnalyzeCollector : public analysis::PointObserver {
     result_.classification = c;
     if (also_ != nullptr) also_->classified(c, r);
   }
+  void checkpoint() override {
+    if (also_ != nullptr) also_->checkpoint();
+  }
   void stage_finished(std::string_view stage) override {
     const auto now = std::chrono::steady_clock::now();
     result_.stage_seconds.emplace_back(std::string(stage),

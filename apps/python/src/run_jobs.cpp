@@ -190,13 +190,11 @@ py::dict simulate(py::kwargs kwargs) {
   return d;
 }
 
-// Ctrl-C looked at before every period of the analysed motion.
+// Ctrl-C looked at at every checkpoint of the analysed motion's ladder (before every period of
+// its records and every integration of its Newton stages, the confirming run's included).
 class AnalyzeCheckpoints : public analysis::PointObserver {
  public:
-  StepObserver steps_of_period(int) override {
-    interrupt_.poll();
-    return {};
-  }
+  void checkpoint() override { interrupt_.poll(); }
 
  private:
   Interrupt interrupt_;

@@ -29,6 +29,7 @@
 // product after Newton's line search has accepted a state is a replay of the line search's own
 // integration (plain integrations are recorded over at most 64 forcing periods). Another state or
 // span, or a caller that takes the integrator, ends the record.
+#include <functional>
 #include <memory>
 
 #include "pwl/integrators/integrator.hpp"
@@ -79,6 +80,11 @@ class StroboscopicMap {
     return *integrator_;
   }
 
+  // Called before every integration of the map (each advance, flow, tangent product that is not
+  // replayed): a caller that abandons the work on a signal (a study told to stop) throws from it.
+  // Empty: nothing is called. The map's results never depend on it.
+  void set_checkpoint(std::function<void()> checkpoint) { checkpoint_ = std::move(checkpoint); }
+
   // Evaluations of the map so far (each one an integration of `periods` periods; the forward
   // differences count one per column). Replayed tangent products are not integrations: they are
   // counted by tangent_replays().
@@ -94,6 +100,7 @@ class StroboscopicMap {
   std::unique_ptr<Integrator> integrator_;
   long evaluations_ = 0;
   long replays_ = 0;
+  std::function<void()> checkpoint_;
   // Plain integrations longer than this many forcing periods are not recorded.
   static constexpr int kReplayPeriods = 64;
   bool recording_ = false;  // the integrator's record_tangent

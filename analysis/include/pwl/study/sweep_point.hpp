@@ -262,6 +262,11 @@ class PointObserver {
   // "attractors"; a confirming run by the accurate method reports none): for a caller that
   // measures what each stage costs. Never changes the result.
   virtual void stage_finished(std::string_view /*stage*/) {}
+  // Called often while the point is evaluated, by every run and stage of the ladder (before every
+  // forcing period of a record, and before every integration of a Newton stage's map), also in a
+  // confirming run that is not otherwise observed: a caller that abandons points on a signal
+  // throws from here, and the point's evaluation ends at once.
+  virtual void checkpoint() {}
 };
 
 // Integrates `point` from `initial_state` ([x; v], 2n; the loads start at phase 0) over

@@ -130,6 +130,7 @@ void confirmation_stage(PointRun& run) {
     }
     try {
       orbits::StroboscopicMap map(run.point, settings.method, settings.steps_per_period);
+      run.watch(map);
       const orbits::OrbitRefinement r =
           orbits::refine_orbit(map, run.points, result.final_state, options);
       if (r.orbit.period == k && (r.explains_motion() || reaches(map, r, result.final_state))) {
@@ -147,7 +148,8 @@ void confirmation_stage(PointRun& run) {
     rerun = true;
   }
   if (!rerun) return;
-  PointRun again(run.point, run.initial_state, settings, nullptr);
+  CheckpointsOnly checkpoints(run.observer);
+  PointRun again(run.point, run.initial_state, settings, &checkpoints);
   run_with_method(again);
   if (again.result.regime == "failed") return;
   again.result.confirmed_by = name;

@@ -91,6 +91,7 @@ void newton_stage(PointRun& run) {
   if (check) options.periods = {result.period};
   try {
     orbits::StroboscopicMap map(run.point, s.method, s.steps_per_period);
+    run.watch(map);
     orbits::OrbitRefinement r = orbits::refine_orbit(map, run.points, result.final_state, options);
     if (refine && !r.explains_motion()) {
       const int locked = locked_denominator(result.rotation, kLockedPeriodLimit);

@@ -89,7 +89,11 @@ void record_stage(PointRun& run) {
   SectionSampler sampler(*integrator, structure, period, s.section, method, s.steps_per_period);
   PointObserver* observer = run.observer;
   if (observer != nullptr) observer->started(*integrator, point);
-  const auto steps_of = [&](int k) { return observer ? observer->steps_of_period(k) : nullptr; };
+  const auto steps_of = [&](int k) {
+    if (observer == nullptr) return StepObserver();
+    observer->checkpoint();
+    return observer->steps_of_period(k);
+  };
 
   PointResult& result = run.result;
   result = PointResult{};

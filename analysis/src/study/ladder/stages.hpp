@@ -29,6 +29,7 @@
 
 #include "pwl/analysis/motion_classifier.hpp"
 #include "pwl/integrators/method_table.hpp"
+#include "pwl/orbits/stroboscopic_map.hpp"
 #include "pwl/study/sweep_point.hpp"
 
 namespace pwl::analysis::ladder {
@@ -63,6 +64,27 @@ struct PointRun {
   void finished(std::string_view stage) const {
     if (observer != nullptr) observer->stage_finished(stage);
   }
+  // PointObserver::checkpoint: may throw to abandon the point.
+  void checkpoint() const {
+    if (observer != nullptr) observer->checkpoint();
+  }
+  // The same, before every integration of a Newton stage's map.
+  void watch(orbits::StroboscopicMap& map) const {
+    if (observer != nullptr) map.set_checkpoint([o = observer] { o->checkpoint(); });
+  }
+};
+
+// Passes on the checkpoints alone: what a confirming run by the accurate method is observed by,
+// so that a study told to stop stops it too, while the caller's files see only the first run.
+class CheckpointsOnly : public PointObserver {
+ public:
+  explicit CheckpointsOnly(PointObserver* to) : to_(to) {}
+  void checkpoint() override {
+    if (to_ != nullptr) to_->checkpoint();
+  }
+
+ private:
+  PointObserver* to_;
 };
 
 constexpr std::size_t kTailPoints = 64;
