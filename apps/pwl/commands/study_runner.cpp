@@ -543,11 +543,7 @@ std::string study_title(const analysis::PointModel& model, const analysis::Point
   // step does): named as a whole when it is the default, else step by step.
   analysis::PointSettings ladder = point;
   ladder.use_ladder();
-  const bool default_ladder = ladder.evidence_periods == point.evidence_periods &&
-                              ladder.refine_max_period == point.refine_max_period &&
-                              ladder.check_periods == point.check_periods &&
-                              ladder.confirm == point.confirm;
-  if (default_ladder) {
+  if (ladder.describe() == point.describe()) {
     title += "; evidence ladder";
   } else if (!point.ladder_on()) {
     title += "; plain record (--quick)";

@@ -34,8 +34,6 @@ namespace pwl::analysis::ladder {
 
 namespace {
 
-constexpr int kLargeCheckPeriods = 2000;  // as newton_stage.cpp: long chains follow fewer periods
-
 bool reruns(Confirmation confirm, const std::string& regime) {
   if (confirm == Confirmation::none) return false;
   if (regime == "uncertain") return true;
@@ -122,12 +120,7 @@ void confirmation_stage(PointRun& run) {
   const std::string name(method_traits(accurate.method).name);
   if (check) {
     const int k = result.period;
-    orbits::RefinementOptions options;
-    options.periods = {k};
-    options.max_period = k;
-    if (run.point.structure.dofs() > PointSettings::kRefinedMasses) {
-      options.max_check_periods = kLargeCheckPeriods;
-    }
+    const orbits::RefinementOptions options = period_check(k, run.point.structure.dofs());
     try {
       orbits::StroboscopicMap map(run.point, settings.method, settings.steps_per_period);
       run.watch(map);

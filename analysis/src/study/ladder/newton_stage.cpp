@@ -33,10 +33,6 @@ namespace pwl::analysis::ladder {
 namespace {
 
 constexpr int kCheckedPeriod = 32;
-// Beyond kRefinedMasses degrees of freedom a period is checked by Newton–Krylov, and the approach
-// to an attracting orbit is followed for at most this many periods (each costs a long chain's
-// period).
-constexpr int kLargeCheckPeriods = 2000;
 
 // The verdict of an orbit that describes the motion.
 void take_orbit(const orbits::OrbitRefinement& r, PointResult& result) {
@@ -68,6 +64,14 @@ bool on_to_record_precision(const orbits::OrbitRefinement& r, int period,
 
 }  // namespace
 
+orbits::RefinementOptions period_check(int period, Index dofs) {
+  orbits::RefinementOptions options;
+  options.periods = {period};
+  options.max_period = period;
+  if (dofs > PointSettings::kRefinedMasses) options.max_check_periods = kLargeCheckPeriods;
+  return options;
+}
+
 void newton_stage(PointRun& run) {
   const PointSettings& s = run.settings;
   PointResult& result = run.result;
@@ -85,10 +89,9 @@ void newton_stage(PointRun& run) {
                       (result.regime == "quasi-periodic" || result.regime == "uncertain") &&
                       !rerun_by_accurate_method(run);
   if (!check && !refine) return;
-  orbits::RefinementOptions options;
+  orbits::RefinementOptions options = period_check(std::max(1, result.period), n);
   options.max_period = std::max({1, s.refine_max_period, result.period});
-  if (!small) options.max_check_periods = kLargeCheckPeriods;
-  if (check) options.periods = {result.period};
+  if (!check) options.periods.clear();  // refinement: the record's candidates
   try {
     orbits::StroboscopicMap map(run.point, s.method, s.steps_per_period);
     run.watch(map);

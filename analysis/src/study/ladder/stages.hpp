@@ -29,6 +29,7 @@
 
 #include "pwl/analysis/motion_classifier.hpp"
 #include "pwl/integrators/method_table.hpp"
+#include "pwl/orbits/orbit_refinement.hpp"
 #include "pwl/orbits/stroboscopic_map.hpp"
 #include "pwl/study/sweep_point.hpp"
 
@@ -115,6 +116,12 @@ int observable_of(const PointSettings& settings, Index dofs);
 
 // newton_stage.cpp.
 void newton_stage(PointRun& run);
+// Newton's settings for a check of `period` on a structure of `dofs` degrees of freedom, by this
+// stage and by the confirmation's Newton on the accurate map: that period alone, and beyond
+// kRefinedMasses the approach to an attracting orbit followed for at most kLargeCheckPeriods
+// periods (each costs a long chain's period) instead of refinement's 20000.
+constexpr int kLargeCheckPeriods = 2000;
+orbits::RefinementOptions period_check(int period, Index dofs);
 
 // transient_stage.cpp. Also fills run.tail.
 void transient_stage(PointRun& run);
