@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <ctime>
+#include <sys/resource.h>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -42,6 +43,11 @@ struct OrbitBenchOptions {
   std::vector<long> settle_periods{10000, 60000, 2000};
   std::vector<int> sizes{100, 1000};  // the medium and the large chain
   int points = 200;                   // continuation points per branch
+  // The matrix-free continuations: the large chain's points, and the huge chain's size and
+  // points.
+  int large_points = 100;
+  int huge_masses = 10000;
+  int huge_points = 20;
   std::string corrector = "automatic";  // the continuations' corrector
   std::vector<std::string> cases;     // only these (keys below); empty: all
   std::string out = "out/bench";
@@ -53,8 +59,9 @@ struct OrbitBenchOptions {
 
 // Keys of --cases.
 const std::vector<std::string>& case_keys() {
-  static const std::vector<std::string> keys{"4a",      "4a-stable",   "medium",
-                                             "large",   "continue-5",  "continue-medium"};
+  static const std::vector<std::string> keys{
+      "4a",         "4a-stable",       "medium",         "large",
+      "continue-5", "continue-medium", "continue-large", "continue-huge"};
   return keys;
 }
 
@@ -406,6 +413,7 @@ struct ContinuationCase {
   NondimensionalChain chain;  // at the start value of θ
   Method method = Method::exact;
   double end = 3.0;
+  int points = 0;  // 0: the options' points
 };
 
 struct ContinuationRow {
@@ -425,6 +433,30 @@ struct ContinuationRow {
   std::vector<orbits::Bifurcation> bifurcations;
   std::vector<std::string> notes;
   std::string failure;
+  // Matrix-free (beyond the dense limit): a cold orbit at the start (`pwl orbit`'s Newton–Krylov
+  // and Arnoldi from the same guess), timed in the same run; the warm points' time (from the
+  // first point accepted to the last, per point); the products per point (the last run); the
+  // process's peak resident memory after the run.
+  bool matrix_free = false;
+  double cold_orbit = 0.0;  // median, s
+  double warm_point = 0.0;  // median, s
+  long krylov_products = 0, arnoldi_products = 0;
+  double peak_rss_mb = 0.0;
+};
+
+// The times at which a continuation's points arrive.
+class PointClock : public orbits::ContinuationObserver {
+ public:
+  void point(const orbits::BranchPoint& /*point*/) override { times_.push_back(Clock::now()); }
+  // Seconds per point from the first point to the last (0 with fewer than two).
+  double per_point() const {
+    if (times_.size() < 2) return 0.0;
+    return std::chrono::duration<double>(times_.back() - times_.front()).count() /
+           static_cast<double>(times_.size() - 1);
+  }
+
+ private:
+  std::vector<Clock::time_point> times_;
 };
 
 std::string bifurcation_list(const ContinuationRow& r, std::size_t at_most) {
@@ -457,7 +489,7 @@ ContinuationRow run_continuation(const ContinuationCase& c, const OrbitBenchOpti
   options.parameter = analysis::SweepParameter::theta;
   options.start = c.chain.theta;
   options.end = c.end;
-  options.max_points = o.points;
+  options.max_points = c.points > 0 ? c.points : o.points;
   options.method.method = c.method;
   options.shooting.tolerance = o.tolerance;
   options.corrector = orbits::parse_corrector(o.corrector);
@@ -470,16 +502,38 @@ ContinuationRow run_continuation(const ContinuationCase& c, const OrbitBenchOpti
     guess = Vector::Zero(map.state_size());
     if (o.transient > 0) guess = map.advance(guess, o.transient);
   }
-  std::vector<double> times, cpus;
+  std::vector<double> times, cpus, colds, warms;
   for (int r = 0; r < o.repeats; ++r) {
+    if (2 * static_cast<Index>(c.chain.masses) > options.shooting.dense_state_limit) {
+      // The cold orbit the warm points are measured against, as `pwl orbit` finds it.
+      say(fmt::format("{}, n = {}: a cold orbit at θ = {}, run {} of {} ...", c.label,
+                      c.chain.masses, c.chain.theta, r + 1, o.repeats));
+      orbits::StroboscopicMap map(model.point_case(), options.method, options.steps_per_period);
+      const Stopwatch cold;
+      try {
+        orbits::find_periodic_orbit(map, guess, options.shooting);
+      } catch (const Error& e) {
+        row.failure = std::string("cold orbit: ") + e.what();
+        break;
+      }
+      colds.push_back(cold.wall_seconds());
+    }
     say(fmt::format("{}, n = {}: continuation of {} points, run {} of {} ...", c.label,
-                    c.chain.masses, o.points, r + 1, o.repeats));
+                    c.chain.masses, options.max_points, r + 1, o.repeats));
     const Stopwatch watch;
     try {
+      PointClock clock;
       const orbits::ContinuationResult result =
-          orbits::continue_periodic_orbit(model, guess, options);
+          orbits::continue_periodic_orbit(model, guess, options, &clock);
       times.push_back(watch.wall_seconds());
       cpus.push_back(watch.cpu_seconds_since());
+      warms.push_back(clock.per_point());
+      row.matrix_free = result.matrix_free;
+      row.krylov_products = result.krylov_products;
+      row.arnoldi_products = result.arnoldi_products;
+      struct rusage usage {};
+      getrusage(RUSAGE_SELF, &usage);
+      row.peak_rss_mb = static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB
       row.points = static_cast<long>(result.points.size());
       row.corrector = orbits::corrector_name(result.corrector);
       row.monodromies = result.monodromies;
@@ -502,6 +556,8 @@ ContinuationRow run_continuation(const ContinuationCase& c, const OrbitBenchOpti
   row.repeats = static_cast<int>(times.size());
   row.seconds = median(times);
   row.cpu = median(cpus);
+  if (!colds.empty()) row.cold_orbit = median(colds);
+  if (!warms.empty()) row.warm_point = median(warms);
   return row;
 }
 
@@ -602,6 +658,7 @@ std::string format_tables(const OrbitBenchOptions& o, const std::vector<Shooting
          "integrations | bifurcations | total s | ms per point | why it stopped |\n";
     t += "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const ContinuationRow& r : continuations) {
+      if (r.matrix_free) continue;
       if (!r.failure.empty()) {
         t += fmt::format(
             "| {} | {} | {} | {} | {:g} → {:g} | - | - | - | - | - | - | failed: {} |\n", r.label,
@@ -617,6 +674,41 @@ std::string format_tables(const OrbitBenchOptions& o, const std::vector<Shooting
                        r.integrations, bifurcation_list(r, 8),
                        seconds_text(r.seconds, r.cpu), r.points > 0 ? 1e3 * r.seconds / static_cast<double>(r.points) : 0.0,
                        notes);
+    }
+    bool header = false;
+    for (const ContinuationRow& r : continuations) {
+      if (!r.matrix_free && r.failure.empty()) continue;
+      if (!r.matrix_free && r.masses * 2 <= 400) continue;
+      if (!header) {
+        t += fmt::format(
+            "\n\nMatrix-free continuation (no monodromy: Newton–Krylov on the bordered system, "
+            "leading multipliers by warm-started Arnoldi), against a cold orbit (Newton–Krylov "
+            "and Arnoldi from the same guess, as `pwl orbit`) at the start in the same run "
+            "(medians of {} runs):\n\n",
+            o.repeats);
+        t += "| case | n | θ asked | θ reached | points | cold orbit s | warm point s | warm / "
+             "cold | GMRES products per point | Arnoldi products per point | bifurcations | "
+             "total s | peak memory MB | why it stopped |\n";
+        t += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+        header = true;
+      }
+      if (!r.failure.empty()) {
+        t += fmt::format("| {} | {} | {:g} → {:g} | - | - | - | - | - | - | - | - | - | - | "
+                         "failed: {} |\n",
+                         r.label, r.masses, r.start, r.end, r.failure);
+        continue;
+      }
+      std::string notes;
+      for (const std::string& n : r.notes) notes += (notes.empty() ? "" : "; ") + n;
+      const double per = r.points > 0 ? 1.0 / static_cast<double>(r.points) : 0.0;
+      t += fmt::format("| {} | {} | {:g} → {:g} | {:.4f} ... {:.4f} | {} | {:.3g} | {:.3g} | "
+                       "{:.2f} | {:.0f} | {:.0f} | {} | {} | {:.0f} | {} |\n",
+                       r.label, r.masses, r.start, r.end, r.lowest, r.highest, r.points,
+                       r.cold_orbit, r.warm_point,
+                       r.cold_orbit > 0 ? r.warm_point / r.cold_orbit : 0.0,
+                       static_cast<double>(r.krylov_products) * per,
+                       static_cast<double>(r.arnoldi_products) * per, bifurcation_list(r, 8),
+                       seconds_text(r.seconds, r.cpu), r.peak_rss_mb, notes);
     }
   }
   return t;
@@ -643,7 +735,8 @@ void write_csv(const std::string& path, const std::vector<ShootingGroup>& groups
              "brute_distance,brute_more_periods,brute_seconds,brute_cpu_seconds,brute_over_shooting,"
              "theta_start,"
              "theta_end,theta_lowest,theta_highest,points,bifurcations,seconds_per_point,"
-             "bifurcation_list,corrector,monodromies,plain_integrations\n");
+             "bifurcation_list,corrector,monodromies,plain_integrations,matrix_free,cold_orbit_seconds,"
+             "warm_point_seconds,gmres_products,arnoldi_products,peak_rss_mb\n");
   for (const ShootingGroup& g : groups) {
     const BruteForce& b = g.brute;
     const std::string status = !b.ran ? "not-run" : b.diverged ? "diverged"
@@ -656,7 +749,7 @@ void write_csv(const std::string& path, const std::vector<ShootingGroup>& groups
       const std::string ratio = comparable ? fmt::format("{:.6g}", b.seconds / r.seconds) : "";
       fmt::print(f,
                  "shooting,{},{},{},{},{},{},{:.6g},{:.6g},{:.6g},{},{},{},{},{},{:.3e},{:.10g},{},{},{},"
-                 "{},{},{:.3e},{:.3e},{:.4g},{:.6g},{:.6g},{},,,,,,,,,,,\n",
+                 "{},{},{:.3e},{:.3e},{:.4g},{:.6g},{:.6g},{},,,,,,,,,,,,,,,,,\n",
                  csv_quoted(r.case_label), r.masses, r.method, r.exact_tangent ? 1 : 0,
                  orbits::shooting_solver_name(r.solver), r.repeats, r.setup, r.seconds, r.cpu,
                  r.converged ? 1 : 0, r.iterations, r.evaluations, r.replays, r.krylov_products, r.residual,
@@ -673,13 +766,15 @@ void write_csv(const std::string& path, const std::vector<ShootingGroup>& groups
                           orbits::bifurcation_name(bif.type), bif.parameter);
     }
     fmt::print(f,
-               "continuation,{},{},{},{},dense,{},,{:.6g},{:.6g},{},,,,,,,,,,,,,,,,,,{:.10g},{:.10g},"
-               "{:.10g},{:.10g},{},{},{:.6g},{},{},{},{}\n",
-               csv_quoted(r.label), r.masses, r.method, r.exact_tangent ? 1 : 0, r.repeats,
-               r.seconds, r.cpu, r.failure.empty() ? 1 : 0, r.start, r.end, r.lowest, r.highest,
-               r.points, r.bifurcations.size(),
+               "continuation,{},{},{},{},{},{},,{:.6g},{:.6g},{},,,,,,,,,,,,,,,,,,{:.10g},{:.10g},"
+               "{:.10g},{:.10g},{},{},{:.6g},{},{},{},{},{},{:.6g},{:.6g},{},{},{:.1f}\n",
+               csv_quoted(r.label), r.masses, r.method, r.exact_tangent ? 1 : 0,
+               r.matrix_free ? "krylov" : "dense", r.repeats, r.seconds, r.cpu,
+               r.failure.empty() ? 1 : 0, r.start, r.end, r.lowest, r.highest, r.points,
+               r.bifurcations.size(),
                r.points > 0 ? r.seconds / static_cast<double>(r.points) : 0.0, csv_quoted(list),
-               r.corrector, r.monodromies, r.integrations);
+               r.corrector, r.monodromies, r.integrations, r.matrix_free ? 1 : 0, r.cold_orbit,
+               r.warm_point, r.krylov_products, r.arnoldi_products, r.peak_rss_mb);
   }
   std::fclose(f);
 }
@@ -710,6 +805,9 @@ void run(OrbitBenchOptions o, bool repeats_given) {
                         std::min<long>(o.settle_periods[1], 2000),
                         std::min<long>(o.settle_periods[2], 100)};
     o.points = std::min(o.points, 20);
+    o.large_points = std::min(o.large_points, 5);
+    o.huge_masses = std::min(o.huge_masses, 250);
+    o.huge_points = std::min(o.huge_points, 3);
     if (!repeats_given) o.repeats = 1;
   }
   const auto say = [&](const std::string& text) {
@@ -751,6 +849,20 @@ void run(OrbitBenchOptions o, bool repeats_given) {
     continuations.push_back(run_continuation({"continue-medium", "figure 4a chain",
                                               fig4a_chain(o.sizes[0], 1.0), Method::pim_switching,
                                               3.0},
+                                             o, say));
+  }
+  // Matrix-free: the paper's size and ten times it, from θ = 1.5 upward (stable period-1 orbits
+  // whose leading multipliers are the long-wave modes crowded against 1).
+  if (wanted(o, "continue-large")) {
+    continuations.push_back(run_continuation({"continue-large", "figure 4a chain, matrix-free",
+                                              fig4a_chain(o.sizes[1], 1.5),
+                                              Method::pim_switching, 1.6, o.large_points},
+                                             o, say));
+  }
+  if (wanted(o, "continue-huge")) {
+    continuations.push_back(run_continuation({"continue-huge", "figure 4a chain, matrix-free",
+                                              fig4a_chain(o.huge_masses, 1.5),
+                                              Method::pim_switching, 1.6, o.huge_points},
                                              o, say));
   }
 
@@ -797,7 +909,8 @@ void add_orbits_bench(CLI::App& bench) {
       ->check(number_in(2, 1000000));
   c->add_option("--points", o->points, "Continuation points per branch")->check(number_in(2, 100000));
   c->add_option("--cases", o->cases,
-                "Only these: 4a, 4a-stable, medium, large, continue-5, continue-medium")
+                "Only these: 4a, 4a-stable, medium, large, continue-5, continue-medium, "
+                "continue-large, continue-huge")
       ->delimiter(',');
   c->add_option("--corrector", o->corrector,
                 "The continuations' corrector: automatic (newton up to 20 state components, chord\n"

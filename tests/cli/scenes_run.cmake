@@ -13,6 +13,7 @@ set(small
   "bench_scaling.toml|bench.sizes=[1000,2000] run.steps=50 run.repeats=1 run.work=1e6"
   "bench_stability.toml|run.quick=true output.no_plot=true output.plots=@"
   "bench_sweep.toml|bench.points=8 run.transient=20 run.periods=100 run.repeats=1"
+  "chain1000_continuation.toml|structure.masses=250 continuation.max_points=3 continuation.record=1,250 run.transient=50"
   "five_dof_continuation.toml|continuation.range=0.65:0.72 continuation.over_sweep=8 continuation.over_periods=40 run.transient=50"
   "five_dof_orbit.toml|"
   "hardening_basins.toml|basin.x_points=21 basin.y_points=21 run.transient=100 run.periods=40"

@@ -308,6 +308,22 @@ TEST_CASE("the step guard accepts the paper's settings and every shipped scene's
   scenes["two_mass_stop"] = {stop_case};
   scenes["two_mass_stop_gap_sweep"] = {stop_case};  // the gaps do not change ω_max
   scenes["bench_chain"] = {paper_chain};
+  {
+    // The 1000-mass chain's matrix-free continuation: θ from 0.8 down to 0.66, the switching PIM
+    // at η = T/200 (the default for orbits beyond 20 masses).
+    for (double theta : {0.66, 0.8}) {
+      NondimensionalChain ch;
+      ch.masses = 1000;
+      ch.alpha = {2.0};
+      ch.zeta = 0.2;
+      ch.gap = {0.0};
+      ch.theta = theta;
+      ch.amplitude.clear();
+      for (int i = 0; i < ch.masses; ++i) ch.amplitude.push_back(i % 2 == 0 ? 1.0 : -1.0);
+      scenes["chain1000_continuation"].push_back(
+          Case{make_chain(ch), fixed_step(Method::pim_switching, ch.period() / 200), ch.period()});
+    }
+  }
   // Benchmarks that choose their steps themselves: bench stability sweeps them into the refused
   // region on purpose (it measures the failures the limits come from), bench accuracy and
   // bench scaling over their own grids, bench orbits and bench curves with the exact solver.

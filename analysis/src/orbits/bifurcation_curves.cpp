@@ -883,6 +883,14 @@ CurvesResult follow_bifurcation_curves(const analysis::PointModel& model,
                                    options.q_from, options.q_to, options.second.name(), q, why));
     }
   }
+  for (const Bifurcation& start : starts) {
+    if (start.state.size() > options.shooting.dense_state_limit) {
+      throw InputError(fmt::format(
+          "bifurcation curves form the {0}x{0} monodromy of their defining systems, which are "
+          "not matrix-free; the dense limit is {1} state components",
+          start.state.size(), options.shooting.dense_state_limit));
+    }
+  }
   CurvesResult result;
   CurvesRunner runner(model, options, observer, result);
   runner.run(starts);

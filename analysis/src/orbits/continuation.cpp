@@ -10,6 +10,9 @@
 #include <map>
 #include <optional>
 
+#include "orbits/bordered_krylov.hpp"
+#include "orbits/open_structure_preconditioner.hpp"
+
 namespace pwl::orbits {
 
 std::string bifurcation_name(BifurcationType type) {
@@ -49,8 +52,9 @@ bool ContinuationOptions::is_valid(std::string* why) const {
     *why = fmt::format("shots = {}: continuation uses single shooting", shooting.shots);
     return false;
   }
-  if (shooting.solver == ShootingSolver::krylov) {
-    *why = "solver = krylov: continuation forms the monodromy (dense solver)";
+  if (shooting.solver == ShootingSolver::krylov && corrector == Corrector::chord) {
+    *why = "corrector = chord: the matrix-free continuation (solver = krylov) corrects by "
+           "Newton-Krylov on the bordered system; use corrector = newton or automatic";
     return false;
   }
   return shooting.is_valid(why);
@@ -109,10 +113,14 @@ std::complex<double> nearest_complex_to_circle(const FloquetMultipliers& mu) {
   return best;
 }
 
-// Re Π (μ_i − target): det(M − target I).
+// Re Π (1 − μ_i / target), target = ±1: det(I − M) or det(I + M) when the multipliers are all of
+// them. With the leading ones only (Arnoldi) the product leaves out multipliers inside the unit
+// circle, each of whose factors is positive (a real μ inside gives 1 ∓ μ > 0, a complex pair
+// |1 ∓ μ|² > 0), so a multiplier that enters or leaves the leading set between two points does
+// not change the sign: the sign changes where, and only where, a real multiplier crosses ±1.
 double product_shifted(const FloquetMultipliers& mu, double target) {
   std::complex<double> product{1.0, 0.0};
-  for (const auto& m : mu.values) product *= m - target;
+  for (const auto& m : mu.values) product *= 1.0 - m / target;
   return product.real();
 }
 
@@ -120,6 +128,7 @@ double product_shifted(const FloquetMultipliers& mu, double target) {
 struct Point : CurvePoint {
   Matrix M;  // monodromy (empty where the corrector did not form it at the point)
   FloquetMultipliers mu;
+  Eigen::MatrixXcd ritz;  // matrix-free: the leading multipliers' Ritz vectors (column i: mu[i])
   Vector b;  // ∂F/∂p
   std::optional<OrbitProfile> profile;
   int formed = 0;  // monodromies the corrector formed before it converged
@@ -154,6 +163,9 @@ constexpr double kPinned = 1e-6;
 // A step whose multipliers' signature is not explained is cut in two at most this many times in
 // a row (2^-30 of the step).
 constexpr int kMaxCuts = 30;
+// Matrix-free: GMRES's relative residual for a tangent of the branch (a direction for the
+// predictor and the orientation of the next: a few digits suffice, ten cost little more).
+constexpr double kTangentTolerance = 1e-10;
 
 class Continuer {
  public:
@@ -171,31 +183,52 @@ class Continuer {
   void run(const Vector& guess) {
     // The first point: Newton at fixed p = start.
     StroboscopicMap& map = map_at(options_.start);
-    if (map.state_size() > options_.shooting.dense_state_limit) {
+    const int period = options_.shooting.period;
+    matrix_free_ = !uses_dense_solver(map, options_.shooting);
+    if (matrix_free_ && options_.corrector == Corrector::chord) {
       throw InputError(fmt::format(
-          "continuation forms the {}x{} monodromy; the dense limit is {} state components",
-          map.state_size(), map.state_size(), options_.shooting.dense_state_limit));
+          "corrector = chord: the {} state components are beyond the dense limit of {}, where "
+          "continuation is matrix-free and corrects by Newton-Krylov; use corrector = newton or "
+          "automatic",
+          map.state_size(), options_.shooting.dense_state_limit));
     }
-    chord_ = options_.corrector == Corrector::chord ||
-             (options_.corrector == Corrector::automatic && map.state_size() > kChordAbove);
+    result_.matrix_free = matrix_free_;
+    chord_ = !matrix_free_ &&
+             (options_.corrector == Corrector::chord ||
+              (options_.corrector == Corrector::automatic && map.state_size() > kChordAbove));
     result_.corrector = chord_ ? Corrector::chord : Corrector::newton;
     ShootingOptions shooting = options_.shooting;
-    shooting.solver = ShootingSolver::dense;
+    shooting.solver = matrix_free_ ? ShootingSolver::krylov : ShootingSolver::dense;
+    shooting.multipliers = !matrix_free_;
+    if (matrix_free_ && options_.shooting.precondition) {
+      open_.emplace(map.structure(), period * map.forcing_period());
+    }
     const PeriodicOrbit orbit = find_periodic_orbit(map, guess, shooting);
     const Index N = orbit.state.size();
     Point first;
     first.u.resize(N + 1);
     first.u << orbit.state, options_.start;
-    first.M = orbit.monodromy;
-    first.mu = orbit.multipliers;
     first.residual = orbit.residual;
     first.iterations = orbit.iterations;
-    first.b = parameter_derivative(orbit.state, options_.start, options_.shooting.period);
+    result_.krylov_products += orbit.krylov_products;
+    first.b = parameter_derivative(orbit.state, options_.start, period);
     // The first tangent: (M − I) z_y = −b z_p with z_p = 1, pointing toward `end`.
-    Eigen::PartialPivLU<Matrix> lu(first.M - Matrix::Identity(N, N));
     Vector z(N + 1);
-    z.head(N) = lu.solve(-first.b);
-    z(N) = 1.0;
+    if (matrix_free_) {
+      leading_multipliers(first, period, nullptr);
+      Vector x;
+      double s = 0;
+      bordered(first.y(), first.p(), period, first.b, Vector::Zero(N), 1.0)
+          .solve(Vector::Zero(N), 1.0, x, s, kTangentTolerance, options_.shooting.gmres_dimension,
+                 options_.shooting.gmres_restarts);
+      z << x, s;
+    } else {
+      first.M = orbit.monodromy;
+      first.mu = orbit.multipliers;
+      Eigen::PartialPivLU<Matrix> lu(first.M - Matrix::Identity(N, N));
+      z.head(N) = lu.solve(-first.b);
+      z(N) = 1.0;
+    }
     if (!z.allFinite()) {
       throw InputError(fmt::format(
           "the orbit at {} = {} has a multiplier at 1: start the continuation elsewhere",
@@ -283,17 +316,135 @@ class Continuer {
     Matrix M_;
   };
 
-  // The corrector from the prediction itself, with the monodromy `monodromy` of the point
-  // predicted from.
-  std::optional<Point> correct(const Vector& prediction, const Vector& tau, const Vector& b,
-                               const Matrix* monodromy, int period) {
-    return correct_from(prediction, prediction, tau, b, period, monodromy,
-                        options_.max_corrections);
+  // The corrector from the prediction itself, from the point `from` (its monodromy for the chord
+  // corrector, its Ritz vectors for a matrix-free one's Arnoldi).
+  std::optional<Point> correct(const Vector& prediction, const Point& from, int period) {
+    return correct_from(prediction, prediction, from.tangent, from.b, period, &from.M,
+                        options_.max_corrections, true, 0.0, &from);
   }
 
-  // The tangent at a corrected point, oriented like `previous`.
-  Vector tangent_at(const Point& pt, const Vector& previous) {
-    return curve_tangent(orbit_jacobian(pt.M, pt.b), previous);
+  // The tangent at a corrected point, oriented like `previous`: [J; previousᵀ] z = e_{m+1}, by LU
+  // on the monodromy or, matrix-free, by GMRES on the bordered system.
+  Vector tangent_at(const Point& pt, const Vector& previous, int period) {
+    if (!matrix_free_) return curve_tangent(orbit_jacobian(pt.M, pt.b), previous);
+    const Index N = pt.n();
+    Vector x;
+    double s = 0;
+    bordered(pt.y(), pt.p(), period, pt.b, previous.head(N), previous(N))
+        .solve(Vector::Zero(N), 1.0, x, s, kTangentTolerance, options_.shooting.gmres_dimension,
+               options_.shooting.gmres_restarts);
+    Vector z(N + 1);
+    z << x, s;
+    z /= z.norm();
+    return z.dot(previous) < 0 ? Vector(-z) : z;
+  }
+
+  // Matrix-free: the open structure's inverse for the map at p over `period` periods (its 2 x 2
+  // blocks retimed where the forcing period moved), or null without one.
+  const detail::OpenStructurePreconditioner* open_at(double p, int period) {
+    if (!open_ || !open_->available()) return nullptr;
+    const double tau = period * map_at(p).forcing_period();
+    if (tau != open_->time()) open_->retime(tau);
+    return &*open_;
+  }
+
+  // Matrix-free: the bordered system [M − I, b; cᵀ, d] at the orbit through y at p, its products
+  // tangent integrations of the map from y (replayed after the first).
+  detail::BorderedKrylov bordered(const Vector& y, double p, int period, const Vector& b,
+                                  const Vector& c, double d) {
+    StroboscopicMap& map = map_at(p);
+    const detail::OpenStructurePreconditioner* open = open_at(p, period);
+    return detail::BorderedKrylov(
+        [this, &map, y, period](const Vector& v) {
+          Matrix t = v;
+          map.advance(y, period, t);
+          ++result_.krylov_products;
+          return Vector(t.col(0));
+        },
+        open, b, c, d);
+  }
+
+  // Matrix-free: the leading multipliers of the orbit at pt and their Ritz vectors, by
+  // thick-restarted Arnoldi warm-started from `warm` (a point nearby): at least the options'
+  // count, and more (doubled) while every one of them lies outside the unit circle, so that all
+  // those outside are among them.
+  void leading_multipliers(Point& pt, int period, const Eigen::MatrixXcd* warm) {
+    StroboscopicMap& map = map_at(pt.p());
+    const Vector y = pt.y();
+    ArnoldiOptions arnoldi = options_.shooting.arnoldi;
+    Eigen::MatrixXcd start;
+    if (warm != nullptr) start = *warm;
+    while (true) {
+      pt.mu = leading_floquet_multipliers(
+          [&](Matrix& v) {
+            map.advance(y, period, v);
+            result_.arnoldi_products += v.cols();
+          },
+          y.size(), arnoldi, start.size() > 0 ? &start : nullptr, &pt.ritz);
+      const bool all_outside = !pt.mu.values.empty() && std::abs(pt.mu.values.back()) > 1.0;
+      if (!all_outside || pt.mu.complete || 2 * arnoldi.count >= arnoldi.krylov_dimension) break;
+      arnoldi.count *= 2;
+      start = pt.ritz;
+    }
+    if (!pt.mu.converged) ++result_.unconverged_multipliers;
+  }
+
+  // Matrix-free corrector: Newton on F(y, p) = 0 with τ · (u − prediction) = 0 from `guess`, each
+  // step the bordered system [M − I, b; τᵀ] δ = −(F, τ · (u − prediction)) solved by GMRES to a
+  // relative residual that tightens as F shrinks (just enough for the next iterate to meet the
+  // tolerance; inexact Newton, S. C. Eisenstat and H. F. Walker, SIAM J. Sci. Comput. 17 (1996)
+  // 16-32). One integration a step (which records the tangent map the step's products replay).
+  // Past the tolerance it polishes as the dense corrector does (CorrectorSettings::polish).
+  std::optional<Point> correct_matrix_free(const Vector& guess, const Vector& prediction,
+                                           const Vector& tau, const Vector& b, int period,
+                                           int iterations, bool multipliers, double polish,
+                                           const Point* near) {
+    const Index N = b.size();
+    Vector u = guess;
+    std::optional<Point> best;
+    double previous = std::numeric_limits<double>::infinity();
+    for (int it = 0;; ++it) {
+      if (!u.allFinite()) break;
+      std::string why;
+      if (!model_.accepts(options_.parameter, u(N), &why)) break;
+      Vector F;
+      try {
+        F = residual(u.head(N), u(N), period, nullptr);
+      } catch (const Error&) {
+        break;
+      }
+      if (!F.allFinite()) break;
+      const double scale = std::max(1.0, u.head(N).lpNorm<Eigen::Infinity>());
+      const double res = F.lpNorm<Eigen::Infinity>();
+      const double arc = tau.dot(u - prediction);
+      const double tolerance = options_.shooting.tolerance * scale;
+      if (res <= tolerance && std::abs(arc) <= tolerance) {
+        if (!best || res < best->residual) {
+          best.emplace();
+          best->u = u;
+          best->residual = res;
+          best->iterations = it;
+        }
+        if (polish <= 0 || res <= polish * scale || res > 0.25 * previous) break;
+      } else if (res > 4 * previous) {
+        break;  // diverging
+      }
+      if (it == iterations) break;
+      const double eta = std::clamp(0.5 * std::min(tolerance, std::max(polish * scale, 1e-16)) /
+                                        std::max(res, 1e-300),
+                                    1e-10, 1e-2);
+      Vector dx;
+      double ds = 0;
+      bordered(u.head(N), u(N), period, b, tau.head(N), tau(N))
+          .solve(-F, -arc, dx, ds, eta, options_.shooting.gmres_dimension,
+                 options_.shooting.gmres_restarts);
+      u.head(N) += dx;
+      u(N) += ds;
+      previous = res;
+    }
+    if (!best) return std::nullopt;
+    if (multipliers) leading_multipliers(*best, period, near != nullptr ? &near->ritz : nullptr);
+    return best;
   }
 
   const OrbitProfile& profile_of(Point& pt, int period) {
@@ -314,7 +465,7 @@ class Continuer {
     bp.orbit.residual = pt.residual;
     bp.orbit.iterations = pt.iterations;
     bp.orbit.exact_tangent = map_at(pt.p()).exact_tangent();
-    bp.orbit.solver = ShootingSolver::dense;
+    bp.orbit.solver = matrix_free_ ? ShootingSolver::krylov : ShootingSolver::dense;
     bp.orbit.multipliers = pt.mu;
     bp.profile = profile_of(pt, period);
     return bp;
@@ -346,10 +497,10 @@ class Continuer {
     const std::string& label() const { return label_; }
 
     std::optional<Point> corrected(const Point& from, const Vector& predicted) override {
-      std::optional<Point> next = c_.correct(predicted, from.tangent, from.b, &from.M, period_);
+      std::optional<Point> next = c_.correct(predicted, from, period_);
       if (!next) return std::nullopt;
       next->b = c_.parameter_derivative(next->y(), next->p(), period_);
-      next->tangent = c_.tangent_at(*next, from.tangent);
+      next->tangent = c_.tangent_at(*next, from.tangent, period_);
       return next;
     }
 
@@ -640,10 +791,10 @@ class Continuer {
     if (chord_) monodromy = 0.5 * (a.M + b.M);
     std::optional<Point> pt = correct_from(guess, prediction, a.tangent, a.b, period,
                                            chord_ ? &monodromy : nullptr,
-                                           options_.max_corrections + 3);
+                                           options_.max_corrections + 3, true, 0.0, &a);
     if (!pt) return std::nullopt;
     pt->b = parameter_derivative(pt->y(), pt->p(), period);
-    pt->tangent = tangent_at(*pt, a.tangent);
+    pt->tangent = tangent_at(*pt, a.tangent, period);
     return pt;
   }
 
@@ -741,7 +892,7 @@ class Continuer {
       std::optional<Point> pt =
           correct_from(guess, prediction, a.tangent, a.b, period, chord_ ? &monodromy : nullptr,
                        options_.max_corrections + 3, type != BifurcationType::grazing,
-                       kLocateResidual);
+                       kLocateResidual, &end_a);
       if (!pt) return std::nullopt;
       const double f = test_function(*pt, type, which, period, variant);
       return std::pair<Point, double>{std::move(*pt), f};
@@ -818,10 +969,19 @@ class Continuer {
   // grazing's trial points, whose test function is the orbit's profile) the chord corrector
   // leaves the orbit's monodromy and multipliers out. A `polish` below the shooting tolerance (a
   // bifurcation's trial points) closes the orbit further (CorrectorSettings::polish).
+  //
+  // Matrix-free (beyond the dense limit) the corrector is correct_matrix_free, Newton-Krylov with
+  // `2 * corrections` steps at most, and the multipliers come from Arnoldi warm-started from the
+  // point `near`'s Ritz vectors.
   std::optional<Point> correct_from(const Vector& guess, const Vector& prediction,
                                     const Vector& tau, const Vector& b, int period,
                                     const Matrix* monodromy, int corrections,
-                                    bool multipliers = true, double polish = 0.0) {
+                                    bool multipliers = true, double polish = 0.0,
+                                    const Point* near = nullptr) {
+    if (matrix_free_) {
+      return correct_matrix_free(guess, prediction, tau, b, period, 2 * corrections, multipliers,
+                                 polish, near);
+    }
     OrbitEquations equations(*this, period, b);
     Matrix start;
     if (chord_ && monodromy != nullptr) start = orbit_jacobian(*monodromy, b);
@@ -850,13 +1010,30 @@ class Continuer {
   void switch_branch(Pending& pd) {
     const int period = 2 * pd.period;
     const Index N = pd.at.n();
-    // The eigenvector of the multiplier nearest −1.
-    Eigen::EigenSolver<Matrix> eig(pd.at.M);
-    Index k = 0;
-    for (Index i = 1; i < eig.eigenvalues().size(); ++i) {
-      if (std::abs(eig.eigenvalues()(i) + 1.0) < std::abs(eig.eigenvalues()(k) + 1.0)) k = i;
+    // The eigenvector of the multiplier nearest −1 (matrix-free: its Ritz vector).
+    Vector v;
+    if (matrix_free_) {
+      Index k = 0;
+      const auto& values = pd.at.mu.values;
+      for (Index i = 1; i < static_cast<Index>(values.size()); ++i) {
+        if (std::abs(values[i] + 1.0) < std::abs(values[k] + 1.0)) k = i;
+      }
+      if (pd.at.ritz.cols() <= k) {
+        note(fmt::format("branch switching at the period doubling at {} = {:.10g}: no eigenvector "
+                         "of its multiplier -1",
+                         options_.parameter.name(), pd.at.p()));
+        return;
+      }
+      const Eigen::VectorXcd w = pd.at.ritz.col(k);
+      v = w.real().norm() >= w.imag().norm() ? Vector(w.real()) : Vector(w.imag());
+    } else {
+      Eigen::EigenSolver<Matrix> eig(pd.at.M);
+      Index k = 0;
+      for (Index i = 1; i < eig.eigenvalues().size(); ++i) {
+        if (std::abs(eig.eigenvalues()(i) + 1.0) < std::abs(eig.eigenvalues()(k) + 1.0)) k = i;
+      }
+      v = eig.eigenvectors().col(k).real();
     }
-    Vector v = eig.eigenvectors().col(k).real();
     v /= v.norm();
     Vector tau0 = Vector::Zero(N + 1);
     tau0.head(N) = v;
@@ -869,7 +1046,7 @@ class Continuer {
       // bordered matrix singular there (M² − I has v in its kernel, and ∂F/∂p lies in its range:
       // a pitchfork of the period-2k map), so the first is formed at y* + ε v.
       std::optional<Point> pt = correct_from(prediction, prediction, tau0, b0, period, nullptr,
-                                             options_.max_corrections + 3);
+                                             options_.max_corrections + 3, true, 0.0, &pd.at);
       if (!pt) continue;
       // A genuine period-2k orbit: not a fixed point of the period-k map.
       Vector Fk;
@@ -883,7 +1060,7 @@ class Continuer {
         continue;
       }
       pt->b = parameter_derivative(pt->y(), pt->p(), period);
-      pt->tangent = tangent_at(*pt, tau0);
+      pt->tangent = tangent_at(*pt, tau0, period);
       ++branches_;
       result_.bifurcations[pd.bifurcation].to_branch = branches_;
       follow(std::move(*pt), branches_, period, pd.period, pd.bifurcation);
@@ -894,7 +1071,8 @@ class Continuer {
     const double range = hi_ - lo_;
     ShootingOptions shooting = options_.shooting;
     shooting.period = period;
-    shooting.solver = ShootingSolver::dense;
+    shooting.solver = matrix_free_ ? ShootingSolver::krylov : ShootingSolver::dense;
+    shooting.multipliers = !matrix_free_;
     for (double delta : {1e-4 * range, 1e-3 * range, 1e-2 * range}) {
       for (double side : {1.0, -1.0}) {
         const double p = pd.at.p() + side * delta;
@@ -911,6 +1089,7 @@ class Continuer {
             pt.mu = orbit.multipliers;
             pt.residual = orbit.residual;
             pt.iterations = orbit.iterations;
+            result_.krylov_products += orbit.krylov_products;
             const Vector Fk = residual(orbit.state, p, pd.period, nullptr);
             if (Fk.lpNorm<Eigen::Infinity>() <=
                 1e3 * options_.shooting.tolerance *
@@ -920,9 +1099,10 @@ class Continuer {
           } catch (const Error&) {
             continue;
           }
+          if (matrix_free_) leading_multipliers(pt, period, &pd.at.ritz);
           pt.b = parameter_derivative(pt.y(), pt.p(), period);
           const Vector away = pt.u - pd.at.u;
-          pt.tangent = tangent_at(pt, away / away.norm());
+          pt.tangent = tangent_at(pt, away / away.norm(), period);
           ++branches_;
           result_.bifurcations[pd.bifurcation].to_branch = branches_;
           follow(std::move(pt), branches_, period, pd.period, pd.bifurcation);
@@ -937,6 +1117,8 @@ class Continuer {
 
   const analysis::PointModel& model_;
   bool chord_ = true;  // the corrector: chord steps, or Newton
+  bool matrix_free_ = false;  // beyond the dense limit: Newton-Krylov and Arnoldi
+  std::optional<detail::OpenStructurePreconditioner> open_;  // matrix-free: GMRES's preconditioner
   const ContinuationOptions& options_;
   ContinuationObserver* observer_;
   ContinuationResult& result_;

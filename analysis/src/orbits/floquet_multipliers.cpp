@@ -75,7 +75,9 @@ bool ArnoldiOptions::is_valid(std::string* why) const {
 }
 
 FloquetMultipliers leading_floquet_multipliers(const std::function<void(Matrix&)>& apply,
-                                               Index size, const ArnoldiOptions& options) {
+                                               Index size, const ArnoldiOptions& options,
+                                               const Eigen::MatrixXcd* warm,
+                                               Eigen::MatrixXcd* vectors) {
   std::string why;
   if (!options.is_valid(&why)) throw InputError(why);
   if (size < 1) throw InputError(fmt::format("operator size = {} must be >= 1", size));
@@ -86,6 +88,14 @@ FloquetMultipliers leading_floquet_multipliers(const std::function<void(Matrix&)
   std::normal_distribution<double> normal;
   Vector start(size);
   for (Index i = 0; i < size; ++i) start(i) = normal(rng);
+  if (warm != nullptr && warm->rows() == size && warm->cols() > 0 && warm->allFinite()) {
+    Vector sum = Vector::Zero(size);
+    for (Index c = 0; c < warm->cols(); ++c) {
+      const double norm = warm->col(c).norm();
+      if (norm > 0) sum += (warm->col(c).real() + warm->col(c).imag()) / norm;
+    }
+    if (sum.norm() > 0) start = sum / sum.norm() + 0.1 * start / start.norm();
+  }
 
   FloquetMultipliers result;
   result.complete = wanted == size;
@@ -133,11 +143,28 @@ FloquetMultipliers leading_floquet_multipliers(const std::function<void(Matrix&)
       return std::abs(beta) * std::abs(s(built - 1)) / s.norm() / scale;
     };
     double worst = 0;
-    const int reported = std::min(wanted, built);
+    int reported = std::min(wanted, built);
+    // A complex pair whole: its second half joins where the count would cut it.
+    if (reported < built) {
+      const std::complex<double> last = eig.eigenvalues()(order[reported - 1]);
+      const auto conjugate_of_last = [&](int r) {
+        return std::abs(eig.eigenvalues()(order[r]) - std::conj(last)) <= 1e-12 * std::abs(last);
+      };
+      const bool paired = reported >= 2 && conjugate_of_last(reported - 2);
+      if (last.imag() != 0.0 && !paired && conjugate_of_last(reported)) ++reported;
+    }
     for (int r = 0; r < reported; ++r) worst = std::max(worst, residual_of(order[r]));
     result.values.clear();
     for (int r = 0; r < reported; ++r) result.values.push_back(eig.eigenvalues()(order[r]));
     result.residual = worst;
+    if (vectors != nullptr) {
+      vectors->resize(size, reported);
+      for (int r = 0; r < reported; ++r) {
+        const Eigen::VectorXcd s = eig.eigenvectors().col(order[r]);
+        vectors->col(r) = V.leftCols(built).cast<std::complex<double>>() * s;
+        vectors->col(r) /= vectors->col(r).norm();
+      }
+    }
     if (worst <= options.tolerance || built < m || restart == options.max_restarts) break;
 
     // Thick restart (G. W. Stewart, SIAM J. Matrix Anal. Appl. 23 (2001) 601-614, Krylov-Schur;
@@ -177,7 +204,26 @@ FloquetMultipliers leading_floquet_multipliers(const std::function<void(Matrix&)
     if (!V.allFinite()) break;
   }
   result.converged = result.residual <= options.tolerance;
-  sort_multipliers(result.values);
+  if (vectors == nullptr) {
+    sort_multipliers(result.values);
+    return result;
+  }
+  // Sorted with their vectors.
+  std::vector<std::complex<double>> sorted = result.values;
+  sort_multipliers(sorted);
+  Eigen::MatrixXcd arranged(size, static_cast<Index>(sorted.size()));
+  std::vector<bool> used(sorted.size(), false);
+  for (std::size_t i = 0; i < sorted.size(); ++i) {
+    for (std::size_t j = 0; j < sorted.size(); ++j) {
+      if (!used[j] && result.values[j] == sorted[i]) {
+        arranged.col(static_cast<Index>(i)) = vectors->col(static_cast<Index>(j));
+        used[j] = true;
+        break;
+      }
+    }
+  }
+  *vectors = std::move(arranged);
+  result.values = std::move(sorted);
   return result;
 }
 

@@ -89,19 +89,31 @@ class OpenStructurePreconditioner {
       omega2 = modes.eigenvalues();
     }
     mass_ = structure.mass;
+    omega2_ = std::move(omega2);
+    modal_damping_ = std::move(modal_damping);
+    available_ = true;
+    retime(tau);
+  }
+
+  bool available() const { return available_; }
+  double time() const { return tau_; }
+
+  // The same structure's map over another time (a continuation in the forcing frequency, whose
+  // period changes and whose structure does not): the 2 x 2 blocks again, the modes kept (O(n)).
+  void retime(double tau) {
+    tau_ = tau;
+    if (!available_) return;
+    const Index n = omega2_.size();
     inverse_.resize(n);
     for (Index k = 0; k < n; ++k) {
-      const double w2 = std::max(0.0, omega2(k));
-      const Eigen::Matrix2d E = exp2x2(w2, modal_damping(k), tau);
+      const double w2 = std::max(0.0, omega2_(k));
+      const Eigen::Matrix2d E = exp2x2(w2, modal_damping_(k), tau);
       const Eigen::Matrix2d J = E - Eigen::Matrix2d::Identity();
       const double det = J.determinant();
       inverse_[k] = std::abs(det) > 1e-12 ? Eigen::Matrix2d(J.inverse())
                                           : Eigen::Matrix2d(-Eigen::Matrix2d::Identity());
     }
-    available_ = true;
   }
-
-  bool available() const { return available_; }
 
   // J0⁻¹ r for a state vector r = [r_x; r_v]: the modal coordinates q = Φ^T M r of each half,
   // the 2 x 2 blocks, and back (Φ z). Matrix-vector products: a two-column product would pack Φ
@@ -152,6 +164,8 @@ class OpenStructurePreconditioner {
   }
 
   bool available_ = false;
+  double tau_ = 0.0;
+  Vector omega2_, modal_damping_;
   Matrix phi_;
   SparseMatrix mass_;
   std::vector<Eigen::Matrix2d> inverse_;

@@ -417,9 +417,21 @@ void continue_orbit(const ContinueFlags& f) {
     fmt::print("notes:\n");
     for (const std::string& note : result.notes) fmt::print("  {}\n", note);
   }
-  fmt::print("work: {} monodromies, {} other integrations of the map; {} step(s) cut to explain "
-             "the multipliers' signature\n",
-             result.monodromies, result.integrations, result.step_cuts);
+  if (result.matrix_free) {
+    fmt::print("work (matrix-free): {} GMRES products, {} Arnoldi products, {} other integrations "
+               "of the map; {} step(s) cut to explain the multipliers' signature\n",
+               result.krylov_products, result.arnoldi_products, result.integrations,
+               result.step_cuts);
+    if (result.unconverged_multipliers > 0) {
+      fmt::print("  at {} point(s) Arnoldi stopped short of its tolerance: their stability rests on "
+                 "unconverged Ritz values\n",
+                 result.unconverged_multipliers);
+    }
+  } else {
+    fmt::print("work: {} monodromies, {} other integrations of the map; {} step(s) cut to explain "
+               "the multipliers' signature\n",
+               result.monodromies, result.integrations, result.step_cuts);
+  }
   fmt::print("time: {:.2f} s ({} points)\n", seconds, outputs.points());
   fmt::print("wrote {0}/branch.csv, {0}/branch_section.csv and {0}/bifurcations.csv\n", o.out);
   if (!f.no_plot) {
@@ -528,8 +540,7 @@ ContinuationProblem continuation_problem(const ContinueFlags& f) {
   c.max_branches = f.max_branches;
   c.method = method.settings;
   c.steps_per_period = method.steps_per_period;
-  c.shooting = shooting_options(o);
-  c.shooting.solver = orbits::ShootingSolver::dense;
+  c.shooting = shooting_options(o);  // automatic: matrix-free beyond the dense limit
   if (!c.is_valid(&why)) throw InputError(why);
 
   ContinuationProblem problem{base, parameter, from, to, dofs, first_case, method, c, {}, 0};
@@ -590,6 +601,7 @@ ContinuationProblem continuation_problem(const ContinueFlags& f) {
   curves.method = c.method;
   curves.steps_per_period = c.steps_per_period;
   curves.shooting = c.shooting;
+  curves.shooting.solver = orbits::ShootingSolver::dense;
   curves.profile_samples = c.profile_samples;
   if (!curves.is_valid(&why)) throw InputError("--curves: " + why);
   problem.curves = curves;

@@ -55,8 +55,23 @@
 // y* + ε v with the projection on v held fixed, checked to be a genuine period-2k orbit, and
 // followed like the first.
 //
-// Continuation forms the monodromy, so it is for structures the dense shooting solver takes
-// (ShootingOptions::dense_state_limit state components).
+// Matrix-free continuation. Up to ShootingOptions::dense_state_limit state components (or with
+// solver = dense) continuation forms the monodromy as above. Beyond it (or with solver = krylov)
+// it never does: the corrector is Newton–Krylov on the bordered system [M − I, ∂F/∂p; τᵀ], solved
+// by GMRES on products M v (tangent integrations of the map from the iterate, replayed from its
+// recorded integration where the integrator records its tangent: the banded switching PIM) and
+// right-preconditioned by the bordered matrix of the open structure (analysis/src/orbits/
+// bordered_krylov.hpp); the tangent is the same bordered solve with the previous tangent as its
+// border; the multipliers are the leading ones by thick-restarted Arnoldi, warm-started from the
+// Ritz vectors of the point before (of the bracket's end, at a bifurcation's trial points), and
+// as many as it takes to have one inside the unit circle, so that every multiplier outside is
+// among them (K. Lust, D. Roose, A. Spence and A. R. Champneys, SIAM J. Sci. Comput. 19 (1998)
+// 1188-1209, the Newton–Picard setting of the same idea). Detection and location are the same
+// code: the signature counts the multipliers outside the circle, which the leading set holds, and
+// the test functions det(I ∓ M) are taken over the leading set, whose left-out factors (of
+// multipliers inside the circle) are all positive, so their sign changes exactly where the whole
+// determinant's does. Branch switching takes the Ritz vector of the multiplier −1. The chord
+// corrector is dense only.
 #include <complex>
 #include <string>
 #include <vector>
@@ -116,7 +131,8 @@ struct ContinuationOptions {
   // The corrector: chord steps on the monodromy of the point predicted from, or Newton, which
   // forms the monodromy at every iterate (the same orbits to the tolerance). Automatic: Newton up
   // to 20 state components, where a monodromy costs about what an integration does (the exact
-  // solver on the 5-DOF chain), chord above, where it costs its 2n tangent columns.
+  // solver on the 5-DOF chain), chord above, where it costs its 2n tangent columns. Matrix-free
+  // (see above) it is Newton–Krylov, and chord is refused.
   Corrector corrector = Corrector::automatic;
   int max_corrections = 7;    // monodromies one corrector may form before it converges
   double locate_tolerance = 1e-10;  // of the bifurcation parameters
@@ -127,7 +143,9 @@ struct ContinuationOptions {
   // The method that integrates the map, and its steps per forcing period (fixed grid).
   MethodSettings method{Method::exact};
   int steps_per_period = 200;
-  ShootingOptions shooting;  // period k, tolerance, Newton at the first point
+  // Period k, tolerance, Newton at the first point; `solver` picks dense or matrix-free (automatic:
+  // by dense_state_limit), and its GMRES and Arnoldi settings are the matrix-free ones.
+  ShootingOptions shooting;
   bool is_valid(std::string* why) const;
 };
 
@@ -151,6 +169,14 @@ struct ContinuationResult {
   long monodromies = 0;
   long integrations = 0;
   long chord_stalls = 0;  // chord steps that stalled, after which the monodromy was formed again
+  // Matrix-free: whether the continuation was (no monodromy formed), its GMRES products (with
+  // M − I, bordered: correctors, tangents, and the first orbit's Newton–Krylov), its Arnoldi
+  // products, and the points whose Arnoldi did not reach its tolerance (their stability rests on
+  // Ritz values short of it).
+  bool matrix_free = false;
+  long krylov_products = 0;
+  long arnoldi_products = 0;
+  long unconverged_multipliers = 0;
   // Steps cut in two because the multipliers' signature changed in a way the events located in
   // them did not explain (several events in one step).
   long step_cuts = 0;

@@ -66,8 +66,19 @@ struct ArnoldiOptions {
 
 // The `count` multipliers of largest modulus of the operator `apply` (which replaces the columns of
 // its argument, size x p, by M times them) by thick-restarted Arnoldi. `complete` is false unless count
-// reaches `size`. Throws InputError for invalid options.
+// reaches `size`. A complex pair is reported whole: the count grows by one where it would cut a
+// pair in two. Throws InputError for invalid options.
+//
+// Warm start (continuation, where the orbit moves little from one point to the next): `warm`, the
+// Ritz vectors of a nearby operator (size x k, complex), starts the iteration from their sum
+// plus a tenth of the fixed random vector, so that the leading subspace is found again in few
+// products while a multiplier that was not among them (one that grows past them) still has a
+// component to grow from. `vectors` (optional) receives the Ritz vectors of the reported
+// multipliers, column i for values[i], each of unit 2-norm: the eigenvector of a multiplier that
+// crosses −1, for branch switching, and the next warm start.
 FloquetMultipliers leading_floquet_multipliers(const std::function<void(Matrix&)>& apply,
-                                               Index size, const ArnoldiOptions& options = {});
+                                               Index size, const ArnoldiOptions& options = {},
+                                               const Eigen::MatrixXcd* warm = nullptr,
+                                               Eigen::MatrixXcd* vectors = nullptr);
 
 }  // namespace pwl::orbits

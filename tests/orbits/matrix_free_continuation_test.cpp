@@ -1,0 +1,67 @@
+// Matrix-free continuation against the dense one where both are cheap: figure 4a's chain with
+// solver = krylov at 10 state components (the matrix-free code path: bordered GMRES, Arnoldi's
+// Ritz vectors), whose period doubling it must locate where the dense continuation does (within
+// 1e-8) and switch onto through the Ritz vector of the multiplier −1, onto genuine period-2
+// orbits. The 150-mass comparison is matrix_free_branch_150_test.cpp, the 1000-mass multipliers
+// chain1000_multipliers_test.cpp.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <complex>
+#include <vector>
+
+#include "continuation_cases.hpp"
+
+using namespace pwl;
+using namespace pwl::orbits;
+using pwl::test::follow;
+using pwl::test::measured;
+
+TEST_CASE("matrix-free continuation locates figure 4a's period doubling and switches branch",
+          "[orbits]") {
+  const NondimensionalChain chain = pwl::test::paper_case_at("4a", 1.1);
+  const MethodSettings method{Method::exact};
+  StroboscopicMap map(analysis::PointCase(chain), method, 1);
+  const auto points = pwl::test::poincare_points(map, Vector::Zero(10), 300, 2);
+  ShootingOptions shooting;
+  const PeriodicOrbit start = find_periodic_orbit(map, 0.5 * (points[0] + points[1]), shooting);
+  ContinuationOptions o;
+  o.parameter = analysis::SweepParameter::theta;
+  o.start = 1.1;
+  o.end = 1.2;
+  o.method = method;
+  o.switch_branches = true;
+  o.max_branches = 1;
+  o.max_points = 80;
+  const ContinuationResult dense = follow(chain, start.state, o, ShootingSolver::dense);
+  const ContinuationResult free = follow(chain, start.state, o, ShootingSolver::krylov);
+  REQUIRE(free.matrix_free);
+  const auto doubling = [](const ContinuationResult& r) -> const Bifurcation* {
+    for (const Bifurcation& b : r.bifurcations) {
+      if (b.branch == 0 && b.type == BifurcationType::period_doubling) return &b;
+    }
+    return nullptr;
+  };
+  const Bifurcation* d = doubling(dense);
+  const Bifurcation* f = doubling(free);
+  REQUIRE(d != nullptr);
+  REQUIRE(f != nullptr);
+  measured("figure 4a: matrix-free period doubling against dense", std::abs(f->parameter - d->parameter));
+  CHECK(std::abs(f->parameter - d->parameter) <= 1e-8);
+  CHECK(std::abs(f->multiplier + 1.0) <= 1e-6);
+  // Switched onto: a period-2 branch of genuine period-2 orbits from the doubling.
+  REQUIRE(f->to_branch == 1);
+  int period_two = 0;
+  for (const BranchPoint& p : free.points) {
+    if (p.branch != 1) continue;
+    ++period_two;
+    CHECK(p.orbit.period == 2);
+    StroboscopicMap at(analysis::PointCase(pwl::test::paper_case_at("4a", p.parameter)), method, 1);
+    const Vector once = at.advance(p.orbit.state, 1);
+    const Vector twice = at.advance(once, 1);
+    CHECK((twice - p.orbit.state).lpNorm<Eigen::Infinity>() <= 1e-8);
+    if (std::abs(p.parameter - f->parameter) > 1e-3) {
+      CHECK((once - p.orbit.state).lpNorm<Eigen::Infinity>() > 1e-4);
+    }
+  }
+  CHECK(period_two >= 5);
+}

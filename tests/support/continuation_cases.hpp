@@ -1,0 +1,39 @@
+#pragma once
+// Continuation cases shared by the matrix-free continuation tests: the paper's chain at any
+// length, the motion settled from rest as a guess, and one branch followed with a given solver.
+#include "orbit_cases.hpp"
+#include "pwl/model/chain_builders.hpp"
+#include "pwl/orbits/continuation.hpp"
+
+namespace pwl::test {
+
+// The paper's chain of `masses` masses (α = 2, ζ = 0.2, Δ̃ = 0, Q alternating ±1) at θ.
+inline NondimensionalChain paper_chain(int masses, double theta) {
+  NondimensionalChain chain;
+  chain.masses = masses;
+  chain.alpha = {2.0};
+  chain.zeta = 0.2;
+  chain.gap = {0.0};
+  chain.amplitude.clear();
+  for (int i = 0; i < masses; ++i) chain.amplitude.push_back(i % 2 == 0 ? 1.0 : -1.0);
+  chain.theta = theta;
+  return chain;
+}
+
+// The state 200 forcing periods after rest (a guess for the period-1 orbit).
+inline Vector settled_guess(const NondimensionalChain& chain, const MethodSettings& method,
+                            int steps) {
+  orbits::StroboscopicMap map(analysis::PointCase(chain), method, steps);
+  return map.advance(Vector::Zero(2 * chain.masses), 200);
+}
+
+// The branch from `guess` with the options `o` and the shooting solver `solver` (dense: the
+// monodromy at every point; krylov: matrix-free).
+inline orbits::ContinuationResult follow(const NondimensionalChain& chain, const Vector& guess,
+                                         orbits::ContinuationOptions o,
+                                         orbits::ShootingSolver solver) {
+  o.shooting.solver = solver;
+  return orbits::continue_periodic_orbit(analysis::PointModel(chain), guess, o);
+}
+
+}  // namespace pwl::test
