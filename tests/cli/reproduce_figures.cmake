@@ -5,9 +5,11 @@ cmake_minimum_required(VERSION 3.25)
 # guide links a figure relative to its own folder (plots/figures/, ../plots/figures/,
 # ../../plots/figures/); each figure counts once. The benchmark charts are the exception: they
 # plot measured times, so they are made by their own scenes (apps/scenes/bench_*.toml), not by
-# `pwl reproduce`, and are named here.
+# `pwl reproduce`, and are named here; so is the 1000-mass chain's frequency response, made by its
+# own scene (apps/scenes/chain1000_continuation.toml: minutes of matrix-free continuation, beyond
+# the paper's figures that `pwl reproduce` remakes).
 # Variables: PWL (the program), SOURCE_DIR (the source tree), WORK_DIR.
-set(timing_charts work_precision_4a work_precision_chain stability)
+set(timing_charts work_precision_4a work_precision_chain stability frequency_response_chain1000)
 file(REMOVE_RECURSE ${WORK_DIR})
 execute_process(COMMAND ${PWL} reproduce --plots ${WORK_DIR}
                 RESULT_VARIABLE status OUTPUT_VARIABLE printed ERROR_VARIABLE errors)
