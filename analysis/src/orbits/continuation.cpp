@@ -430,9 +430,8 @@ class Continuer {
         break;  // diverging
       }
       if (it == iterations) break;
-      const double eta = std::clamp(0.5 * std::min(tolerance, std::max(polish * scale, 1e-16)) /
-                                        std::max(res, 1e-300),
-                                    1e-10, 1e-2);
+      const double target = polish > 0 ? std::min(tolerance, polish * scale) : tolerance;
+      const double eta = std::clamp(0.5 * target / std::max(res, 1e-300), 1e-10, 1e-2);
       Vector dx;
       double ds = 0;
       bordered(u.head(N), u(N), period, b, tau.head(N), tau(N))
