@@ -1,14 +1,16 @@
 // The Newton-Krylov preconditioner J0⁻¹ = (M0 − I)⁻¹, M0 the monodromy of the open structure
 // (every gap spring open), against M0 from Eigen's matrix exponential of the 2n x 2n state
 // matrix: J0⁻¹ (M0 − I) v must give v back, on each of its three ways to the modes (a diagonal
-// mass with a tridiagonal or a wider stiffness, and a consistent, non-diagonal mass), and a
-// damping that is not classical must leave it unavailable.
+// mass with a tridiagonal or a wider stiffness, a consistent, non-diagonal mass, and the uniform
+// fixed-free chain's closed-form modes by sine transforms), and a damping that is not classical
+// must leave it unavailable.
 #include <catch2/catch.hpp>
 #include <random>
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include "orbit_cases.hpp"
 #include "orbits/open_structure_preconditioner.hpp"
+#include "pwl/model/chain_builders.hpp"
 #include "pwl/model/gap_structure.hpp"
 #include "test_structures.hpp"
 
@@ -68,6 +70,7 @@ TEST_CASE("The open structure's preconditioner inverts M0 − I on each of its p
   SECTION("diagonal mass, tridiagonal stiffness (QR on the tridiagonal K̃ directly)") {
     const Matrix K = line_stiffness(n, 0.0);
     const Matrix C = 0.04 * diagonal_mass + 0.02 * K;  // Rayleigh: classical
+    CHECK_FALSE(OpenStructurePreconditioner(open_structure(diagonal_mass, K, C), tau).closed_form());
     CHECK(round_trip_error(open_structure(diagonal_mass, K, C), tau) <= 1e-11);
   }
   SECTION("diagonal mass, stiffness of bandwidth 2 (dense symmetric K̃)") {
@@ -81,6 +84,20 @@ TEST_CASE("The open structure's preconditioner inverts M0 − I on each of its p
     const Matrix K = line_stiffness(n, 0.0);
     const Matrix C = 0.04 * M + 0.02 * K;
     CHECK(round_trip_error(open_structure(M, K, C), tau) <= 1e-11);
+  }
+  SECTION("uniform fixed-free chain: closed-form modes, sine transforms by FFT or Bluestein") {
+    // 2(2n+1) = 30 and 66 factor into small primes (Eigen's FFT directly); 94 = 2 · 47 and
+    // 602 = 2 · 7 · 43 take Bluestein's convolution.
+    for (const Index size : {Index(7), Index(16), Index(23), Index(150)}) {
+      const Matrix M = 1.7 * Matrix::Identity(size, size);
+      const Matrix K = 2.3 * Matrix(fixed_free_laplacian(size));
+      for (const double a : {0.0, 0.05}) {
+        const Matrix C = a * M + 0.2 / 2.3 * K;  // the paper's c = 0.2 between masses when a = 0
+        INFO("n = " << size << ", a = " << a);
+        CHECK(OpenStructurePreconditioner(open_structure(M, K, C), tau).closed_form());
+        CHECK(round_trip_error(open_structure(M, K, C), tau) <= 1e-11);
+      }
+    }
   }
   SECTION("a dashpot at one end only is not classical damping: unavailable on every path") {
     Matrix C = Matrix::Zero(n, n);
@@ -101,5 +118,11 @@ TEST_CASE("The open structure's preconditioner inverts M0 − I on each of its p
     Matrix near = 0.04 * diagonal_mass + 0.02 * K;
     near(3, 3) *= 1.0 + 1e-6;
     CHECK_FALSE(OpenStructurePreconditioner(open_structure(diagonal_mass, K, near), tau).available());
+    // Nor is it, on the closed-form path's test, for a uniform chain with such a damping.
+    const Matrix uniform = Matrix(fixed_free_laplacian(n));
+    CHECK_FALSE(OpenStructurePreconditioner(
+                    open_structure(Matrix::Identity(n, n), uniform, C), tau)
+                    .available());
   }
 }
+

@@ -17,6 +17,10 @@
 // K̃ ψ = ω² ψ, K̃ = M^-½ K M^-½ and φ = M^-½ ψ, and when K̃ is tridiagonal (a chain of nearest
 // neighbours) its QR iteration starts from K̃ itself, with no Householder reduction and no
 // reduced basis to form (the whole set-up 1.52 s -> 0.79 s for the paper's 1000-mass chain).
+// A uniform fixed-free chain (equal masses and springs, Rayleigh damping: the paper's chain) has
+// its modes in closed form and goes to and from them by sine transforms (fixed_free_chain_modes.hpp):
+// no decomposition and no n x n matrix, O(n log n) per application, which is what makes 10^4 masses
+// and more affordable (the decomposition would take O(n³) and Φ 8 n² bytes).
 // Classical damping is checked column by column: Φ^T C Φ is diagonal exactly when
 // C φ_k = d_k M φ_k for every mode, and since M^½ Φ is orthogonal, column k of Φ^T C Φ − diag(d)
 // has the 2-norm of M^-½ (C φ_k − d_k M φ_k): sparse products, O(n² · bandwidth), instead of two
@@ -32,8 +36,10 @@
 #include <cstdlib>
 #include <cmath>
 #include <complex>
+#include <optional>
 #include <vector>
 
+#include "orbits/fixed_free_chain_modes.hpp"
 #include "pwl/integrators/banded_pim_integrator.hpp"
 #include "pwl/model/gap_structure.hpp"
 
@@ -45,7 +51,10 @@ class OpenStructurePreconditioner {
   OpenStructurePreconditioner(const GapStructure& structure, double tau) {
     const Index n = structure.dofs();
     Vector omega2, modal_damping;
-    if (!banded_layout(structure).diagonal_mass) {
+    if (auto chain = uniform_chain_modes(structure, modal_damping)) {
+      chain_.emplace(std::move(*chain));
+      omega2 = chain_->omega2();
+    } else if (!banded_layout(structure).diagonal_mass) {
       // The generalised problem, dense, and Φ^T C Φ formed whole.
       const Matrix M = Matrix(structure.mass);
       Eigen::GeneralizedSelfAdjointEigenSolver<Matrix> modes(Matrix(structure.stiffness), M);
@@ -88,7 +97,7 @@ class OpenStructurePreconditioner {
       }
       omega2 = modes.eigenvalues();
     }
-    mass_ = structure.mass;
+    if (!chain_) mass_ = structure.mass;
     omega2_ = std::move(omega2);
     modal_damping_ = std::move(modal_damping);
     available_ = true;
@@ -96,6 +105,8 @@ class OpenStructurePreconditioner {
   }
 
   bool available() const { return available_; }
+  // Whether the modes are the uniform chain's closed form (no decomposition, no n x n matrix).
+  bool closed_form() const { return chain_.has_value(); }
   double time() const { return tau_; }
 
   // The same structure's map over another time (a continuation in the forcing frequency, whose
@@ -118,10 +129,17 @@ class OpenStructurePreconditioner {
   // J0⁻¹ r for a state vector r = [r_x; r_v]: the modal coordinates q = Φ^T M r of each half,
   // the 2 x 2 blocks, and back (Φ z). Matrix-vector products: a two-column product would pack Φ
   // for the matrix-matrix kernel on every call, which costs more than a second pass over it.
+  // A uniform fixed-free chain goes to its modes and back by sine transforms instead (O(n log n)).
+  // Not for concurrent calls on one object (the transforms share their work space).
   Vector apply(const Vector& r) const {
-    const Index n = phi_.rows();
-    const Vector qx = phi_.transpose() * (mass_ * r.head(n));
-    const Vector qv = phi_.transpose() * (mass_ * r.tail(n));
+    const Index n = omega2_.size();
+    Vector qx, qv;
+    if (chain_) {
+      chain_->to_modal(r.head(n), r.tail(n), qx, qv);
+    } else {
+      qx = phi_.transpose() * (mass_ * r.head(n));
+      qv = phi_.transpose() * (mass_ * r.tail(n));
+    }
     Vector zx(n), zv(n);
     for (Index k = 0; k < n; ++k) {
       const Eigen::Vector2d z = inverse_[k] * Eigen::Vector2d(qx(k), qv(k));
@@ -129,8 +147,12 @@ class OpenStructurePreconditioner {
       zv(k) = z(1);
     }
     Vector out(2 * n);
-    out.head(n).noalias() = phi_ * zx;
-    out.tail(n).noalias() = phi_ * zv;
+    if (chain_) {
+      chain_->from_modal(zx, zv, out.head(n), out.tail(n));
+    } else {
+      out.head(n).noalias() = phi_ * zx;
+      out.tail(n).noalias() = phi_ * zv;
+    }
     return out;
   }
 
@@ -152,6 +174,48 @@ class OpenStructurePreconditioner {
     return std::exp(half_trace) * (ch * Eigen::Matrix2d::Identity() + sh_over_s * B);
   }
 
+  // The closed-form modes when the structure is a uniform fixed-free chain (M = m I, K = k L) with
+  // Rayleigh damping C = a M + b K, and its modal damping a + b ω_k² in `modal_damping`; nothing
+  // otherwise (the eigen-decomposition then decides). Entries are compared to 1e-13 of the largest.
+  static std::optional<FixedFreeChainModes> uniform_chain_modes(const GapStructure& s,
+                                                                Vector& modal_damping) {
+    const Index n = s.dofs();
+    if (n < 2 || !banded_layout(s).diagonal_mass) return std::nullopt;
+    const double m = s.mass.coeff(0, 0);
+    const Vector masses = s.mass.diagonal();
+    if (!(m > 0) || (masses.array() - m).abs().maxCoeff() > 1e-13 * m) return std::nullopt;
+    const double k = -s.stiffness.coeff(1, 0);
+    const double b_off = -s.damping.coeff(1, 0);  // −C[1][0] = b k
+    const double a_m = s.damping.coeff(0, 0) - 2.0 * b_off;  // C[0][0] = a m + 2 b k
+    if (!(k > 0) || !std::isfinite(k)) return std::nullopt;
+    // K = k L and C = a m I + (b k) L entry by entry, nothing stored off the three diagonals.
+    const auto matches = [&](const SparseMatrix& A, double diagonal_shift, double factor) {
+      const double tol = 1e-13 * std::max({std::abs(factor), std::abs(diagonal_shift), 1e-300});
+      Index diagonal_count = 0, neighbour_count = 0;
+      for (Index c = 0; c < A.outerSize(); ++c) {
+        for (SparseMatrix::InnerIterator it(A, c); it; ++it) {
+          const Index i = it.row(), j = it.col();
+          double expected = 0.0;
+          if (i == j) {
+            expected = diagonal_shift + factor * (i + 1 < n ? 2.0 : 1.0);
+            ++diagonal_count;
+          } else if (std::abs(i - j) == 1) {
+            expected = -factor;
+            ++neighbour_count;
+          }
+          if (std::abs(it.value() - expected) > tol) return false;
+        }
+      }
+      // A missing entry is a zero where one may be expected.
+      if (std::abs(diagonal_shift) + std::abs(factor) == 0.0) return true;
+      return diagonal_count == n && (factor == 0.0 || neighbour_count == 2 * (n - 1));
+    };
+    if (!matches(s.stiffness, 0.0, k) || !matches(s.damping, a_m, b_off)) return std::nullopt;
+    FixedFreeChainModes modes(n, m, k);
+    modal_damping = Vector::Constant(n, a_m / m) + (b_off / m) * modes.laplacian_eigenvalues();
+    return modes;
+  }
+
   // The largest |i − j| of a stored non-zero.
   static Index bandwidth(const SparseMatrix& A) {
     Index w = 0;
@@ -166,8 +230,9 @@ class OpenStructurePreconditioner {
   bool available_ = false;
   double tau_ = 0.0;
   Vector omega2_, modal_damping_;
-  Matrix phi_;
+  Matrix phi_;  // the general paths' modal matrix (Φ^T M Φ = I)
   SparseMatrix mass_;
+  std::optional<FixedFreeChainModes> chain_;  // instead of Φ for a uniform fixed-free chain
   std::vector<Eigen::Matrix2d> inverse_;
 };
 

@@ -12,6 +12,10 @@ namespace pwl::orbits {
 
 namespace {
 
+// A spring's direction w (g = wᵀx − Δ) kept sparse: it touches one or two degrees of freedom, so
+// that the gap functions of 10^4 springs along an orbit cost O(springs · samples), not times n.
+using Direction = Eigen::SparseVector<double>;
+
 struct Sample {
   double t;
   Vector x, v;
@@ -91,7 +95,7 @@ struct Interpolated {
   double value, time;
   std::size_t at;
 };
-Interpolated interpolated_extreme(const std::vector<Sample>& samples, const Vector& w, double gap,
+Interpolated interpolated_extreme(const std::vector<Sample>& samples, const Direction& w, double gap,
                                   bool maximum) {
   const double inf = std::numeric_limits<double>::infinity();
   Interpolated best{maximum ? -inf : inf, 0.0, 0};
@@ -112,7 +116,7 @@ Interpolated interpolated_extreme(const std::vector<Sample>& samples, const Vect
 // The extreme refined on the exact motion (a method that stops anywhere): bisection on the sign of
 // g' over its sample interval and its neighbours, where the extreme may sit at a sample. Keeps
 // `extreme` where no interior extreme of the kind is found.
-void refine_extreme(Integrator& integrator, const std::vector<Sample>& samples, const Vector& w,
+void refine_extreme(Integrator& integrator, const std::vector<Sample>& samples, const Direction& w,
                     double gap, bool maximum, std::size_t s, double& value, double& time) {
   const double inf = std::numeric_limits<double>::infinity();
   bool found = false;
@@ -159,7 +163,7 @@ OrbitProfile orbit_profile(StroboscopicMap& map, const Vector& state, int period
   const std::vector<Sample> samples = sample_orbit(map, state, periods, samples_per_period);
   const Index n = map.dofs();
   const GapStructure& structure = map.structure();
-  const Matrix W = structure.spring_directions();
+  const SparseMatrix W = structure.spring_directions_sparse();
   const Vector gaps = structure.spring_gaps();
   const bool on_grid = method_traits(map.settings().method).fixed_grid;
 
@@ -187,10 +191,10 @@ OrbitProfile orbit_profile(StroboscopicMap& map, const Vector& state, int period
   profile.amplitude = profile.max_position.cwiseAbs().cwiseMax(profile.min_position.cwiseAbs());
   for (Index j = 0; j < springs; ++j) {
     for (const bool maximum : {true, false}) {
-      const Interpolated e = interpolated_extreme(samples, W.col(j), gaps(j), maximum);
+      const Direction w = W.col(j);
+      const Interpolated e = interpolated_extreme(samples, w, gaps(j), maximum);
       double value = e.value, time = e.time;
-      if (!on_grid) refine_extreme(map.integrator(), samples, W.col(j), gaps(j), maximum, e.at,
-                                   value, time);
+      if (!on_grid) refine_extreme(map.integrator(), samples, w, gaps(j), maximum, e.at, value, time);
       (maximum ? profile.max_gap : profile.min_gap)(j) = value;
       (maximum ? profile.max_gap_time : profile.min_gap_time)(j) = time;
     }
@@ -205,7 +209,7 @@ GapExtreme gap_extreme(StroboscopicMap& map, const Vector& state, int periods, i
     throw InputError(fmt::format("spring {} of {}", spring + 1, structure.spring_count()));
   }
   const std::vector<Sample> samples = sample_orbit(map, state, periods, samples_per_period);
-  const Vector w = structure.spring_directions().col(spring);
+  const Direction w = structure.spring_directions_sparse().col(spring);
   const double gap = structure.spring_gaps()(spring);
   const Interpolated e = interpolated_extreme(samples, w, gap, largest);
   GapExtreme out{e.value, e.time};
