@@ -8,6 +8,7 @@
 #include <catch2/catch.hpp>
 #include <complex>
 #include <random>
+#include <vector>
 
 #include "orbit_cases.hpp"
 #include "pwl/model/chain_builders.hpp"
@@ -81,7 +82,22 @@ TEST_CASE("Newton-Krylov and dense Newton find the same periodic orbit of a 50-m
   const PeriodicOrbit dense = find_periodic_orbit(map, seed, options);
   options.solver = ShootingSolver::krylov;
   options.arnoldi.count = 6;
+  // The progress hook sees every iteration in order, with the GMRES products spent so far.
+  std::vector<int> iterations;
+  std::vector<long> products;
+  double last_residual = -1.0;
+  options.on_iteration = [&](int iteration, double residual, long spent) {
+    iterations.push_back(iteration);
+    products.push_back(spent);
+    last_residual = residual;
+  };
   const PeriodicOrbit krylov = find_periodic_orbit(map, seed, options);
+  REQUIRE(iterations.size() == static_cast<std::size_t>(krylov.iterations) + 1);
+  for (std::size_t i = 0; i < iterations.size(); ++i) CHECK(iterations[i] == static_cast<int>(i));
+  CHECK(products.front() == 0);
+  CHECK(products.back() == krylov.krylov_products);
+  CHECK(std::is_sorted(products.begin(), products.end()));
+  CHECK(last_residual == krylov.residual);
   REQUIRE(dense.solver == ShootingSolver::dense);
   REQUIRE(krylov.solver == ShootingSolver::krylov);
   CHECK(krylov.monodromy.size() == 0);

@@ -199,6 +199,7 @@ PeriodicOrbit find_periodic_orbit(StroboscopicMap& map, const Vector& guess,
     Vector G = shooting_residual(map, arcs, Y, &M);
     double residual = inf_norm(G);
     for (int iteration = 0;; ++iteration) {
+      if (options.on_iteration) options.on_iteration(iteration, residual, 0);
       if (!G.allFinite()) throw fail("met a non-finite state", residual, iteration);
       if (converged(residual, Y)) {
         Matrix monodromy = M[0];
@@ -268,6 +269,7 @@ PeriodicOrbit find_periodic_orbit(StroboscopicMap& map, const Vector& guess,
     return orbit;
   };
   for (int iteration = 0;; ++iteration) {
+    if (options.on_iteration) options.on_iteration(iteration, residual, krylov_products);
     if (!F.allFinite()) throw fail("met a non-finite state", residual, iteration);
     if (converged(residual, y)) return krylov_answer(iteration);
     if (iteration == options.max_iterations) throw fail("did not converge", residual, iteration);

@@ -166,6 +166,14 @@ class ContinueOutputs : public orbits::ContinuationObserver {
 
   void finish_progress() { progress_.finish(); }
 
+  // Newton on the first orbit, before any point (minutes for a chain of 10^4 masses).
+  void newton(int iteration, double residual, long products) {
+    if (points_ > 0 || !progress_.due(iteration == 0)) return;
+    progress_.show(fmt::format("continue: the first orbit, Newton iteration {}, residual {:.2e}, "
+                               "{} GMRES products, {:.1f} s",
+                               iteration, residual, products, progress_.seconds()));
+  }
+
   long points() const { return points_; }
   const std::map<int, long>& per_branch() const { return per_branch_; }
   const std::map<int, long>& stable() const { return stable_; }
@@ -289,7 +297,7 @@ void draw_frequency_response(const ContinueFlags& f, const ContinueOutputs& outp
         "yname={7}; title={8}",
         out, format, 5 + plotted, 9 + plotted, last_branch + 1, periods + counts,
         gnuplot_quoted(parameter_label(parameter)),
-        gnuplot_quoted(fmt::format("amplitude max |x_{}(t)| over the orbit{}", dofs.back() + 1,
+        gnuplot_quoted(fmt::format("amplitude max |x_{{{}}}(t)| over the orbit{}", dofs.back() + 1,
                                    chain ? " (nondimensional)" : "")),
         gnuplot_quoted(title));
   };
@@ -344,7 +352,7 @@ void run_over_sweep(const ContinueFlags& f, const analysis::PointModel& model,
         "scolumn={2}; bifurcations='{1}/bifurcations.csv'; bxcolumn={7}; {8}"
         "out='{1}/branch_over_diagram.{3}'; xname={4}; yname={5}; title={6}",
         run.out, f.orbit.out, 5 + recorded, format, gnuplot_quoted(parameter_label(parameter)),
-        gnuplot_quoted(fmt::format("x_{} at t = kT{}", dof + 1,
+        gnuplot_quoted(fmt::format("x_{{{}}} at t = kT{}", dof + 1,
                                    model.explicit_structure() ? "" : " (nondimensional)")),
         gnuplot_quoted(title), 9 + 2 * recorded, counts);
   };
@@ -392,8 +400,12 @@ void continue_orbit(const ContinueFlags& f) {
   const StopSignals signals;
   ContinueOutputs outputs(o.out, base, parameter, method, dofs, !o.quiet);
   orbits::ContinuationResult result;
+  orbits::ContinuationOptions with_progress = c;
+  with_progress.shooting.on_iteration = [&outputs](int iteration, double residual, long products) {
+    outputs.newton(iteration, residual, products);
+  };
   try {
-    result = orbits::continue_periodic_orbit(base, guess, c, &outputs);
+    result = orbits::continue_periodic_orbit(base, guess, with_progress, &outputs);
   } catch (...) {
     outputs.finish_progress();
     throw;

@@ -14,6 +14,7 @@
 #include "commands/orbit_command.hpp"
 #include "commands/orbit_options.hpp"
 #include "output/csv_writer.hpp"
+#include "output/progress_line.hpp"
 #include "pwl/errors.hpp"
 #include "pwl/orbits/orbit_profile.hpp"
 #include "pwl/orbits/periodic_orbit.hpp"
@@ -56,7 +57,23 @@ void orbit(const OrbitCommandFlags& f) {
   orbits::StroboscopicMap& map = *problem.map;
   note_when_no_tangent_map(map);
   const Vector guess = starting_guess(o, map);
-  const orbits::PeriodicOrbit orbit = orbits::find_periodic_orbit(map, guess, problem.shooting);
+  ProgressLine progress(!o.quiet);
+  orbits::ShootingOptions shooting = problem.shooting;
+  shooting.on_iteration = [&progress](int iteration, double residual, long products) {
+    if (!progress.due(iteration == 0)) return;
+    progress.show(fmt::format("orbit: Newton iteration {}, residual {:.2e}, {} GMRES products, {:.1f} s",
+                              iteration, residual, products, progress.seconds()));
+  };
+  const orbits::PeriodicOrbit orbit = [&] {
+    try {
+      const orbits::PeriodicOrbit found = orbits::find_periodic_orbit(map, guess, shooting);
+      progress.finish();
+      return found;
+    } catch (...) {
+      progress.finish();
+      throw;
+    }
+  }();
   const orbits::PeriodicOrbit minimal = orbits::at_minimal_period(map, orbit, problem.shooting);
 
   std::filesystem::create_directories(o.out);

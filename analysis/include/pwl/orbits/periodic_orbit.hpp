@@ -37,6 +37,7 @@
 //
 // Globalisation: a step that does not decrease |F|_2 enough is halved (backtracking) down to
 // 1/1024; Newton stops with a ShootingError that says the residual reached when it cannot go on.
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -75,6 +76,10 @@ struct ShootingOptions {
   // Floquet multipliers: all for the dense form; the leading `floquet_count` for Krylov.
   bool multipliers = true;
   ArnoldiOptions arnoldi;
+  // Progress (optional): called at the start of every Newton iteration with its number, the
+  // residual |φ(y) − y|_∞ so far and the GMRES products spent (0 for the dense form). A long chain's
+  // cold orbit takes minutes (6 min at 10^4 masses); a program shows this to say it is alive.
+  std::function<void(int iteration, double residual, long products)> on_iteration;
   bool is_valid(std::string* why) const;
 };
 
