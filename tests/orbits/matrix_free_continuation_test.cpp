@@ -35,14 +35,8 @@ TEST_CASE("matrix-free continuation locates figure 4a's period doubling and swit
   const ContinuationResult dense = follow(chain, start.state, o, ShootingSolver::dense);
   const ContinuationResult free = follow(chain, start.state, o, ShootingSolver::krylov);
   REQUIRE(free.matrix_free);
-  const auto doubling = [](const ContinuationResult& r) -> const Bifurcation* {
-    for (const Bifurcation& b : r.bifurcations) {
-      if (b.branch == 0 && b.type == BifurcationType::period_doubling) return &b;
-    }
-    return nullptr;
-  };
-  const Bifurcation* d = doubling(dense);
-  const Bifurcation* f = doubling(free);
+  const Bifurcation* d = pwl::test::first_doubling(dense);
+  const Bifurcation* f = pwl::test::first_doubling(free);
   REQUIRE(d != nullptr);
   REQUIRE(f != nullptr);
   measured("figure 4a: matrix-free period doubling against dense", std::abs(f->parameter - d->parameter));

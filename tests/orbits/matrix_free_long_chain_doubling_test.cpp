@@ -20,6 +20,7 @@
 
 using namespace pwl;
 using namespace pwl::orbits;
+using pwl::test::first_doubling;
 using pwl::test::follow;
 using pwl::test::measured;
 using pwl::test::paper_chain;
@@ -28,13 +29,6 @@ namespace {
 
 constexpr int kMasses = 100;
 constexpr double kFrom = 0.5192, kTo = 0.5200;
-
-const Bifurcation* first_doubling(const ContinuationResult& r) {
-  for (const Bifurcation& b : r.bifurcations) {
-    if (b.branch == 0 && b.type == BifurcationType::period_doubling) return &b;
-  }
-  return nullptr;
-}
 
 // The period-1 branch point of `r` nearest θ.
 const BranchPoint* nearest(const ContinuationResult& r, double theta) {

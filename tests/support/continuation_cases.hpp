@@ -36,4 +36,12 @@ inline orbits::ContinuationResult follow(const NondimensionalChain& chain, const
   return orbits::continue_periodic_orbit(analysis::PointModel(chain), guess, o);
 }
 
+// The first period doubling located on branch 0 (the branch followed from the start), or nullptr.
+inline const orbits::Bifurcation* first_doubling(const orbits::ContinuationResult& r) {
+  for (const orbits::Bifurcation& b : r.bifurcations) {
+    if (b.branch == 0 && b.type == orbits::BifurcationType::period_doubling) return &b;
+  }
+  return nullptr;
+}
+
 }  // namespace pwl::test

@@ -366,8 +366,8 @@ class Continuer {
 
   // Matrix-free: the leading multipliers of the orbit at pt and their Ritz vectors, by
   // thick-restarted Arnoldi warm-started from `warm` (a point nearby): at least the options'
-  // count, and more (doubled) while every one of them lies outside the unit circle, so that all
-  // those outside are among them.
+  // count, and more (doubled) while every one of them lies outside the unit circle and Arnoldi
+  // converged, so that all those outside are among them.
   void leading_multipliers(Point& pt, int period, const Eigen::MatrixXcd* warm) {
     StroboscopicMap& map = map_at(pt.p());
     const Vector y = pt.y();
@@ -382,7 +382,13 @@ class Continuer {
           },
           y.size(), arnoldi, start.size() > 0 ? &start : nullptr, &pt.ritz);
       const bool all_outside = !pt.mu.values.empty() && std::abs(pt.mu.values.back()) > 1.0;
-      if (!all_outside || pt.mu.complete || 2 * arnoldi.count >= arnoldi.krylov_dimension) break;
+      // Only converged values are worth more of them: Ritz values short of their tolerance can sit
+      // outside the circle with nothing there (a 10^4-mass chain's crowded long waves: 1.00007
+      // at a residual of 3e-2), and each doubling would be another whole unconverged Arnoldi.
+      if (!all_outside || !pt.mu.converged || pt.mu.complete ||
+          2 * arnoldi.count >= arnoldi.krylov_dimension) {
+        break;
+      }
       arnoldi.count *= 2;
       start = pt.ritz;
     }
