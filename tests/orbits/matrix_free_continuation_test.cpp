@@ -5,6 +5,7 @@
 // orbits. The 150-mass comparison is matrix_free_branch_150_test.cpp, the 1000-mass multipliers
 // chain1000_multipliers_test.cpp.
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <vector>
@@ -58,4 +59,35 @@ TEST_CASE("matrix-free continuation locates figure 4a's period doubling and swit
     }
   }
   CHECK(period_two >= 5);
+}
+
+TEST_CASE("matrix-free continuation claims no stability change from multipliers that did not converge",
+          "[orbits]") {
+  // The same branch with Arnoldi starved (a basis of 3 for 10 state components, no restart): its
+  // Ritz values are not the multipliers, and the period doubling the dense continuation locates
+  // on this branch must not be claimed from them, nor any other stability change; the result
+  // counts the points and says why in a note.
+  const NondimensionalChain chain = pwl::test::paper_case_at("4a", 1.1);
+  const MethodSettings method{Method::exact};
+  StroboscopicMap map(analysis::PointCase(chain), method, 1);
+  const auto points = pwl::test::poincare_points(map, Vector::Zero(10), 300, 2);
+  const PeriodicOrbit start =
+      find_periodic_orbit(map, 0.5 * (points[0] + points[1]), ShootingOptions{});
+  ContinuationOptions o;
+  o.parameter = analysis::SweepParameter::theta;
+  o.start = 1.1;
+  o.end = 1.2;
+  o.method = method;
+  o.max_points = 80;
+  o.shooting.arnoldi.count = 2;
+  o.shooting.arnoldi.krylov_dimension = 3;
+  o.shooting.arnoldi.max_restarts = 0;
+  const ContinuationResult starved = follow(chain, start.state, o, ShootingSolver::krylov);
+  REQUIRE(starved.matrix_free);
+  CHECK(starved.unconverged_multipliers > 0);
+  for (const Bifurcation& b : starved.bifurcations) CHECK(b.type == BifurcationType::grazing);
+  const bool noted = std::any_of(starved.notes.begin(), starved.notes.end(), [](const std::string& n) {
+    return n.find("did not converge") != std::string::npos;
+  });
+  CHECK(noted);
 }

@@ -9,6 +9,7 @@
 #include <limits>
 #include <map>
 #include <optional>
+#include <set>
 
 #include "orbits/bordered_krylov.hpp"
 #include "orbits/open_structure_preconditioner.hpp"
@@ -482,6 +483,7 @@ class Continuer {
   }
 
   static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+  std::set<int> unconverged_noted_;  // branches whose unconverged multipliers were noted
 
   // The walk of one branch on the core's loop: its corrector, the checks that end a switched
   // branch (it rejoins its parent, or closes on itself), the events between its points, and the
@@ -664,7 +666,17 @@ class Continuer {
   // They are recorded in their order along the branch.
   void detect(Point& a, Point& b, double h, int branch, int period) {
     step_found_.clear();
-    explain_signature(a, b, h, branch, period, 0);
+    if (a.mu.converged && b.mu.converged) {
+      explain_signature(a, b, h, branch, period, 0);
+    } else if (unconverged_noted_.insert(branch).second) {
+      // Ritz values short of their tolerance can cross the circle with nothing crossing there:
+      // a change of signature between them is not an event, and locating it would run Arnoldi
+      // again at every trial point for nothing (the count of such points is in the result).
+      note(fmt::format("on branch {} the leading multipliers did not converge from {} = {:.10g} "
+                       "(Arnoldi short of its tolerance): no stability change is detected across "
+                       "a step with such an end; grazings still are",
+                       branch, options_.parameter.name(), a.mu.converged ? b.p() : a.p()));
+    }
     if (options_.grazing) {
       const OrbitProfile& pa = profile_of(a, period);
       const OrbitProfile& pb = profile_of(b, period);
