@@ -17,24 +17,38 @@ using namespace pwl::orbits;
 using pwl::test::follow;
 using pwl::test::measured;
 
-TEST_CASE("matrix-free continuation locates figure 4a's period doubling and switches branch",
-          "[orbits]") {
-  const NondimensionalChain chain = pwl::test::paper_case_at("4a", 1.1);
-  const MethodSettings method{Method::exact};
+namespace {
+
+// Figure 4a's period-1 orbit at θ = 1.1 (Newton from the middle of its settled period-2 motion).
+Vector figure_4a_orbit(const NondimensionalChain& chain, const MethodSettings& method) {
   StroboscopicMap map(analysis::PointCase(chain), method, 1);
   const auto points = pwl::test::poincare_points(map, Vector::Zero(10), 300, 2);
-  ShootingOptions shooting;
-  const PeriodicOrbit start = find_periodic_orbit(map, 0.5 * (points[0] + points[1]), shooting);
+  return find_periodic_orbit(map, 0.5 * (points[0] + points[1]), ShootingOptions{}).state;
+}
+
+// Its branch in θ from 1.1 toward 1.2, past the period doubling.
+ContinuationOptions figure_4a_options(const MethodSettings& method) {
   ContinuationOptions o;
   o.parameter = analysis::SweepParameter::theta;
   o.start = 1.1;
   o.end = 1.2;
   o.method = method;
+  o.max_points = 80;
+  return o;
+}
+
+}  // namespace
+
+TEST_CASE("matrix-free continuation locates figure 4a's period doubling and switches branch",
+          "[orbits]") {
+  const NondimensionalChain chain = pwl::test::paper_case_at("4a", 1.1);
+  const MethodSettings method{Method::exact};
+  const Vector start = figure_4a_orbit(chain, method);
+  ContinuationOptions o = figure_4a_options(method);
   o.switch_branches = true;
   o.max_branches = 1;
-  o.max_points = 80;
-  const ContinuationResult dense = follow(chain, start.state, o, ShootingSolver::dense);
-  const ContinuationResult free = follow(chain, start.state, o, ShootingSolver::krylov);
+  const ContinuationResult dense = follow(chain, start, o, ShootingSolver::dense);
+  const ContinuationResult free = follow(chain, start, o, ShootingSolver::krylov);
   REQUIRE(free.matrix_free);
   const Bifurcation* d = pwl::test::first_doubling(dense);
   const Bifurcation* f = pwl::test::first_doubling(free);
@@ -45,19 +59,9 @@ TEST_CASE("matrix-free continuation locates figure 4a's period doubling and swit
   CHECK(std::abs(f->multiplier + 1.0) <= 1e-6);
   // Switched onto: a period-2 branch of genuine period-2 orbits from the doubling.
   REQUIRE(f->to_branch == 1);
-  int period_two = 0;
-  for (const BranchPoint& p : free.points) {
-    if (p.branch != 1) continue;
-    ++period_two;
-    CHECK(p.orbit.period == 2);
-    StroboscopicMap at(analysis::PointCase(pwl::test::paper_case_at("4a", p.parameter)), method, 1);
-    const Vector once = at.advance(p.orbit.state, 1);
-    const Vector twice = at.advance(once, 1);
-    CHECK((twice - p.orbit.state).lpNorm<Eigen::Infinity>() <= 1e-8);
-    if (std::abs(p.parameter - f->parameter) > 1e-3) {
-      CHECK((once - p.orbit.state).lpNorm<Eigen::Infinity>() > 1e-4);
-    }
-  }
+  const int period_two = pwl::test::check_period_two_branch(
+      free, 1, f->parameter, [](double theta) { return pwl::test::paper_case_at("4a", theta); },
+      method, 1, 1e-3, 1e-4);
   CHECK(period_two >= 5);
 }
 
@@ -69,20 +73,12 @@ TEST_CASE("matrix-free continuation claims no stability change from multipliers 
   // counts the points and says why in a note.
   const NondimensionalChain chain = pwl::test::paper_case_at("4a", 1.1);
   const MethodSettings method{Method::exact};
-  StroboscopicMap map(analysis::PointCase(chain), method, 1);
-  const auto points = pwl::test::poincare_points(map, Vector::Zero(10), 300, 2);
-  const PeriodicOrbit start =
-      find_periodic_orbit(map, 0.5 * (points[0] + points[1]), ShootingOptions{});
-  ContinuationOptions o;
-  o.parameter = analysis::SweepParameter::theta;
-  o.start = 1.1;
-  o.end = 1.2;
-  o.method = method;
-  o.max_points = 80;
+  ContinuationOptions o = figure_4a_options(method);
   o.shooting.arnoldi.count = 2;
   o.shooting.arnoldi.krylov_dimension = 3;
   o.shooting.arnoldi.max_restarts = 0;
-  const ContinuationResult starved = follow(chain, start.state, o, ShootingSolver::krylov);
+  const ContinuationResult starved =
+      follow(chain, figure_4a_orbit(chain, method), o, ShootingSolver::krylov);
   REQUIRE(starved.matrix_free);
   CHECK(starved.unconverged_multipliers > 0);
   for (const Bifurcation& b : starved.bifurcations) CHECK(b.type == BifurcationType::grazing);

@@ -97,19 +97,9 @@ TEST_CASE("a long chain's period doubling, matrix-free: located as dense and swi
 
   // Switched onto: genuine period-2 orbits.
   REQUIRE(f->to_branch == 1);
-  int period_two = 0;
-  for (const BranchPoint& p : free.points) {
-    if (p.branch != 1) continue;
-    ++period_two;
-    CHECK(p.orbit.period == 2);
-    StroboscopicMap at(analysis::PointCase(paper_chain(kMasses, p.parameter)), method, 200);
-    const Vector once = at.advance(p.orbit.state, 1);
-    const Vector twice = at.advance(once, 1);
-    CHECK((twice - p.orbit.state).lpNorm<Eigen::Infinity>() <= 1e-8);
-    if (std::abs(p.parameter - f->parameter) > 1e-4) {
-      CHECK((once - p.orbit.state).lpNorm<Eigen::Infinity>() > 1e-5);
-    }
-  }
+  const int period_two = pwl::test::check_period_two_branch(
+      free, 1, f->parameter, [](double theta) { return paper_chain(kMasses, theta); }, method, 200,
+      1e-4, 1e-5);
   measured("long chain: period-2 points switched onto", period_two);
   CHECK(period_two >= 5);
 }

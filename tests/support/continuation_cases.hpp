@@ -1,6 +1,10 @@
 #pragma once
 // Continuation cases shared by the matrix-free continuation tests: the paper's chain at any
-// length, the motion settled from rest as a guess, and one branch followed with a given solver.
+// length, the motion settled from rest as a guess, one branch followed with a given solver, and
+// the checks they share (the first period doubling, a switched period-2 branch's orbits).
+#include <catch2/catch.hpp>
+#include <cmath>
+
 #include "orbit_cases.hpp"
 #include "pwl/model/chain_builders.hpp"
 #include "pwl/orbits/continuation.hpp"
@@ -42,6 +46,30 @@ inline const orbits::Bifurcation* first_doubling(const orbits::ContinuationResul
     if (b.branch == 0 && b.type == orbits::BifurcationType::period_doubling) return &b;
   }
   return nullptr;
+}
+
+// Checks that the points of `branch` are genuine period-2 orbits of the chain `at(θ)`: period 2,
+// carried twice round by a fresh map (method, steps a period) back onto themselves to 1e-8, and,
+// farther than `near` in θ from the doubling at `doubling`, not once round (by more than `apart`).
+// Returns how many points it checked.
+template <class ChainAt>
+int check_period_two_branch(const orbits::ContinuationResult& r, int branch, double doubling,
+                            ChainAt&& at, const MethodSettings& method, int steps, double near,
+                            double apart) {
+  int checked = 0;
+  for (const orbits::BranchPoint& p : r.points) {
+    if (p.branch != branch) continue;
+    ++checked;
+    CHECK(p.orbit.period == 2);
+    orbits::StroboscopicMap map(analysis::PointCase(at(p.parameter)), method, steps);
+    const Vector once = map.advance(p.orbit.state, 1);
+    const Vector twice = map.advance(once, 1);
+    CHECK((twice - p.orbit.state).lpNorm<Eigen::Infinity>() <= 1e-8);
+    if (std::abs(p.parameter - doubling) > near) {
+      CHECK((once - p.orbit.state).lpNorm<Eigen::Infinity>() > apart);
+    }
+  }
+  return checked;
 }
 
 }  // namespace pwl::test
