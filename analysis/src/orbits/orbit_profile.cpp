@@ -190,8 +190,8 @@ OrbitProfile orbit_profile(StroboscopicMap& map, const Vector& state, int period
   }
   profile.amplitude = profile.max_position.cwiseAbs().cwiseMax(profile.min_position.cwiseAbs());
   for (Index j = 0; j < springs; ++j) {
+    const Direction w = W.col(j);
     for (const bool maximum : {true, false}) {
-      const Direction w = W.col(j);
       const Interpolated e = interpolated_extreme(samples, w, gaps(j), maximum);
       double value = e.value, time = e.time;
       if (!on_grid) refine_extreme(map.integrator(), samples, w, gaps(j), maximum, e.at, value, time);

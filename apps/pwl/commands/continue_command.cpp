@@ -169,9 +169,8 @@ class ContinueOutputs : public orbits::ContinuationObserver {
   // Newton on the first orbit, before any point (minutes for a chain of 10^4 masses).
   void newton(int iteration, double residual, long products) {
     if (points_ > 0 || !progress_.due(iteration == 0)) return;
-    progress_.show(fmt::format("continue: the first orbit, Newton iteration {}, residual {:.2e}, "
-                               "{} GMRES products, {:.1f} s",
-                               iteration, residual, products, progress_.seconds()));
+    progress_.show(newton_progress_text("continue: the first orbit", iteration, residual, products,
+                                        progress_.seconds()));
   }
 
   long points() const { return points_; }

@@ -61,8 +61,7 @@ void orbit(const OrbitCommandFlags& f) {
   orbits::ShootingOptions shooting = problem.shooting;
   shooting.on_iteration = [&progress](int iteration, double residual, long products) {
     if (!progress.due(iteration == 0)) return;
-    progress.show(fmt::format("orbit: Newton iteration {}, residual {:.2e}, {} GMRES products, {:.1f} s",
-                              iteration, residual, products, progress.seconds()));
+    progress.show(newton_progress_text("orbit", iteration, residual, products, progress.seconds()));
   };
   const orbits::PeriodicOrbit orbit = [&] {
     try {

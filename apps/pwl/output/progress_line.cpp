@@ -40,4 +40,10 @@ void ProgressLine::finish() {
   drawn_ = false;
 }
 
+std::string newton_progress_text(const std::string& what, int iteration, double residual,
+                                 long products, double seconds) {
+  return fmt::format("{}: Newton iteration {}, residual {:.2e}, {} GMRES products, {:.1f} s", what,
+                     iteration, residual, products, seconds);
+}
+
 }  // namespace pwl::app

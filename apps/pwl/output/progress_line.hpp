@@ -25,4 +25,9 @@ class ProgressLine {
   std::chrono::steady_clock::time_point start_, last_;
 };
 
+// The line of a Newton iteration on a periodic orbit ("<what>: Newton iteration k, residual r, p
+// GMRES products, s s"), the same for `pwl orbit` and `pwl continue`'s first orbit.
+std::string newton_progress_text(const std::string& what, int iteration, double residual,
+                                 long products, double seconds);
+
 }  // namespace pwl::app
