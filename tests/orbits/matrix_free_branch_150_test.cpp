@@ -18,20 +18,6 @@ using pwl::test::follow;
 using pwl::test::paper_chain;
 using pwl::test::settled_guess;
 
-namespace {
-// The multipliers' count outside the unit circle at the branch's point nearest θ.
-int unstable_near(const ContinuationResult& r, double theta, double* at) {
-  const BranchPoint* best = nullptr;
-  for (const BranchPoint& p : r.points) {
-    if (best == nullptr || std::abs(p.parameter - theta) < std::abs(best->parameter - theta)) {
-      best = &p;
-    }
-  }
-  *at = best->parameter;
-  return best->orbit.multipliers.unstable_count();
-}
-
-}  // namespace
 
 TEST_CASE("the 150-mass chain's branch is the same matrix-free as dense", "[orbits]") {
   const double from = 0.745, to = 0.70;
@@ -81,8 +67,10 @@ TEST_CASE("the 150-mass chain's branch is the same matrix-free as dense", "[orbi
   // The same stability: at every matrix-free point, as many multipliers outside the circle as at
   // the dense branch's point nearest it when no bifurcation lies between the two.
   for (const BranchPoint& p : free.points) {
-    double at = 0;
-    const int expected = unstable_near(dense, p.parameter, &at);
+    const BranchPoint* q = pwl::test::nearest_point(dense, 0, p.parameter);
+    REQUIRE(q != nullptr);
+    const double at = q->parameter;
+    const int expected = q->orbit.multipliers.unstable_count();
     bool between = false;
     for (const Bifurcation& b : dense.bifurcations) {
       if (b.type == BifurcationType::grazing) continue;

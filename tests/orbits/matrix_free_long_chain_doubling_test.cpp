@@ -30,18 +30,6 @@ namespace {
 constexpr int kMasses = 100;
 constexpr double kFrom = 0.5192, kTo = 0.5200;
 
-// The period-1 branch point of `r` nearest θ.
-const BranchPoint* nearest(const ContinuationResult& r, double theta) {
-  const BranchPoint* best = nullptr;
-  for (const BranchPoint& p : r.points) {
-    if (p.branch != 0) continue;
-    if (best == nullptr || std::abs(p.parameter - theta) < std::abs(best->parameter - theta)) {
-      best = &p;
-    }
-  }
-  return best;
-}
-
 }  // namespace
 
 TEST_CASE("a long chain's period doubling, matrix-free: located as dense and switched onto",
@@ -82,7 +70,7 @@ TEST_CASE("a long chain's period doubling, matrix-free: located as dense and swi
   int compared = 0, most_unstable = 0;
   for (const BranchPoint& p : free.points) {
     if (p.branch != 0) continue;
-    const BranchPoint* q = nearest(dense, p.parameter);
+    const BranchPoint* q = pwl::test::nearest_point(dense, 0, p.parameter);
     REQUIRE(q != nullptr);
     if (std::abs(q->parameter - p.parameter) > 1e-9) continue;  // the two branches' steps differ
     INFO("theta = " << p.parameter);

@@ -48,6 +48,19 @@ inline const orbits::Bifurcation* first_doubling(const orbits::ContinuationResul
   return nullptr;
 }
 
+// The point of `branch` nearest θ (null when the branch has none).
+inline const orbits::BranchPoint* nearest_point(const orbits::ContinuationResult& r, int branch,
+                                                double theta) {
+  const orbits::BranchPoint* best = nullptr;
+  for (const orbits::BranchPoint& p : r.points) {
+    if (p.branch != branch) continue;
+    if (best == nullptr || std::abs(p.parameter - theta) < std::abs(best->parameter - theta)) {
+      best = &p;
+    }
+  }
+  return best;
+}
+
 // Checks that the points of `branch` are genuine period-2 orbits of the chain `at(θ)`: period 2,
 // carried twice round by a fresh map (method, steps a period) back onto themselves to 1e-8, and,
 // farther than `near` in θ from the doubling at `doubling`, not once round (by more than `apart`).
