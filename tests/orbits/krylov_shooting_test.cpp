@@ -4,10 +4,12 @@
 // multipliers must be the leading eigenvalues of the dense monodromy. Restarted Arnoldi alone on a
 // matrix whose eigenvalues are known by construction.
 #include <Eigen/QR>
+#include <omp.h>
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <complex>
 #include <random>
+#include <tuple>
 #include <vector>
 
 #include "orbit_cases.hpp"
@@ -233,15 +235,31 @@ TEST_CASE("thick-restarted Arnoldi resolves long-wave multipliers crowded agains
   };
   ArnoldiOptions options;
   options.count = 6;
-  const FloquetMultipliers found = leading_floquet_multipliers(apply, n, options);
-  measured("crowded multipliers: residual", found.residual);
-  measured("crowded multipliers: products", static_cast<double>(products));
-  CHECK(found.converged);
-  const double distance = set_distance(expected, found.values);
-  measured("crowded multipliers: error", distance);
-  CHECK(distance <= 1e-9);
-  CHECK(found.largest_modulus() == Approx(1.0 - 4e-6).epsilon(1e-12));
-  CHECK(found.stable());
+  // Plain Arnoldi, and block Krylov-Schur taking 2 and 3 columns a product.
+  for (const int block : {1, 2, 3}) {
+    INFO("block " << block);
+    options.block = block;
+    products = 0;
+    long calls = 0, wrong_width = 0;
+    const FloquetMultipliers found = leading_floquet_multipliers(
+        [&](Matrix& v) {
+          ++calls;
+          if (v.cols() != block) ++wrong_width;
+          apply(v);
+        },
+        n, options);
+    measured("crowded multipliers: residual", found.residual);
+    measured("crowded multipliers: products", static_cast<double>(products));
+    CHECK(wrong_width == 0);
+    CHECK(products == calls * block);
+    CHECK(found.converged);
+    const double distance = set_distance(expected, found.values);
+    measured("crowded multipliers: error", distance);
+    CHECK(distance <= 1e-9);
+    CHECK(found.largest_modulus() == Approx(1.0 - 4e-6).epsilon(1e-12));
+    CHECK(found.stable());
+  }
+  options.block = 1;
   options.krylov_dimension = 60;
   products = 0;
   const FloquetMultipliers small = leading_floquet_multipliers(apply, n, options);
@@ -285,6 +303,16 @@ TEST_CASE(
   measured("Arnoldi without restarts: residual", once.residual);
   CHECK(once.residual > 1e-12);  // 20 vectors are not enough ...
   options.max_restarts = 60;
+  // The same by blocks of 2 columns a product.
+  for (const int block : {2}) {
+    INFO("block " << block);
+    ArnoldiOptions blocked = options;
+    blocked.block = block;
+    const FloquetMultipliers by_blocks = leading_floquet_multipliers(apply, n, blocked);
+    measured("restarted block Krylov-Schur: residual", by_blocks.residual);
+    CHECK(by_blocks.residual <= 1e-12);
+    CHECK(set_distance(expected, by_blocks.values) <= 1e-10);
+  }
   products = 0;
   const FloquetMultipliers restarted = leading_floquet_multipliers(apply, n, options);
   measured("restarted Arnoldi: residual", restarted.residual);
@@ -306,4 +334,80 @@ TEST_CASE(
       leading_floquet_multipliers([&](Matrix& v) { v = small * v; }, 6, options);
   CHECK(all.complete);
   CHECK(set_distance(floquet_multipliers(small).values, all.values) <= 1e-12);
+  // Blocks near the operator's size, 10x10: a basis of 8 and blocks of 2 fill the space exactly;
+  // a basis of 10 leaves no room for a block beside it (single columns then, as plain Arnoldi
+  // ends on the whole space). Both give the leading four of the dense solver.
+  const Matrix ten = A.topLeftCorner(10, 10);
+  const std::vector<Complex> dense_ten = floquet_multipliers(ten).values;
+  for (const auto& [dimension, block, width] : {std::tuple{8, 2, 2}, std::tuple{10, 3, 1}}) {
+    INFO("basis " << dimension << ", block " << block);
+    ArnoldiOptions near_size = options;
+    near_size.count = 4;
+    near_size.krylov_dimension = dimension;
+    near_size.block = block;
+    near_size.max_restarts = 60;
+    long wrong_width = 0;
+    const FloquetMultipliers leading_four = leading_floquet_multipliers(
+        [&](Matrix& v) {
+          if (v.cols() != width) ++wrong_width;
+          v = ten * v;
+        },
+        10, near_size);
+    CHECK(wrong_width == 0);
+    REQUIRE(leading_four.values.size() >= 4);
+    CHECK(leading_four.converged);
+    CHECK(set_distance(std::vector<Complex>(dense_ten.begin(), dense_ten.begin() + 4),
+                       std::vector<Complex>(leading_four.values.begin(),
+                                            leading_four.values.begin() + 4)) <= 1e-11);
+  }
+}
+
+TEST_CASE("a product of several columns is split over two integrators, bit for bit", "[orbits]") {
+  // From 1000 state components (500 masses) on, the banded switching PIM's map applies the second
+  // half of a several-column product on a second integrator, in parallel: every column must come
+  // out as the single-column product of a fresh map (integrated, not replayed) and as the same
+  // product on one thread, to the last bit; and Arnoldi by blocks of two on that map must find
+  // the leading multipliers plain Arnoldi finds.
+  const NondimensionalChain chain = contact_chain(500);
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(2);  // the split, even on a one-core machine
+  StroboscopicMap map = banded_switching_map(chain), fresh = banded_switching_map(chain);
+  CHECK(map.tangent_block() == 2);
+  CHECK(banded_switching_map(contact_chain(499)).tangent_block() == 1);
+  const Vector y = map.advance(pwl::test::harmonic_response(map.structure(), chain.theta), 3);
+  Matrix V(map.state_size(), 3);
+  for (Index i = 0; i < V.rows(); ++i) {
+    V(i, 0) = std::sin(0.3 + 0.9 * static_cast<double>(i));
+    V(i, 1) = std::cos(1.1 + 0.4 * static_cast<double>(i));
+    V(i, 2) = std::sin(2.0 + 0.05 * static_cast<double>(i));
+  }
+  Matrix split = V;
+  const Vector end = map.advance(y, 1, split);
+  for (Index c = 0; c < V.cols(); ++c) {
+    Matrix column = V.col(c);
+    const Vector fresh_end = fresh.advance(y + 1e-3 * Vector::Ones(y.size()), 1);  // another arc
+    CHECK(fresh_end.allFinite());
+    fresh.advance(y, 1, column);  // integrated again (the last arc was another)
+    CHECK((column.col(0) - split.col(c)).cwiseAbs().maxCoeff() == 0.0);
+  }
+  omp_set_num_threads(1);
+  Matrix serial = V;
+  CHECK((map.advance(y, 1, serial) - end).cwiseAbs().maxCoeff() == 0.0);
+  CHECK((serial - split).cwiseAbs().maxCoeff() == 0.0);
+  CHECK(split.cwiseAbs().maxCoeff() > 0.1);
+  omp_set_num_threads(2);
+
+  ArnoldiOptions plain;
+  plain.count = 6;
+  ArnoldiOptions blocks = plain;
+  blocks.block = map.tangent_block();
+  const auto apply = [&](Matrix& v) { map.advance(y, 1, v); };
+  const FloquetMultipliers one = leading_floquet_multipliers(apply, map.state_size(), plain);
+  const FloquetMultipliers two = leading_floquet_multipliers(apply, map.state_size(), blocks);
+  CHECK(one.converged);
+  CHECK(two.converged);
+  const double distance = set_distance(one.values, two.values);
+  measured("500 masses: Arnoldi by blocks of two against plain Arnoldi", distance);
+  CHECK(distance <= 1e-9);
+  omp_set_num_threads(threads);
 }

@@ -373,6 +373,7 @@ class Continuer {
     StroboscopicMap& map = map_at(pt.p());
     const Vector y = pt.y();
     ArnoldiOptions arnoldi = options_.shooting.arnoldi;
+    arnoldi.block = map.tangent_block();
     Eigen::MatrixXcd start;
     if (warm != nullptr) start = *warm;
     while (true) {

@@ -58,6 +58,10 @@ bool ArnoldiOptions::is_valid(std::string* why) const {
     *why = fmt::format("floquet count = {} must be >= 1", count);
     return false;
   }
+  if (block < 1) {
+    *why = fmt::format("arnoldi block = {} must be >= 1", block);
+    return false;
+  }
   if (krylov_dimension <= count) {
     *why = fmt::format("krylov dimension = {} must exceed the count of multipliers {}",
                        krylov_dimension, count);
@@ -99,36 +103,71 @@ FloquetMultipliers leading_floquet_multipliers(const std::function<void(Matrix&)
 
   FloquetMultipliers result;
   result.complete = wanted == size;
-  // The Krylov-Schur relation A V_j = V_j G_j + g v_{j+1} e_j^T, G upper Hessenberg except, after
-  // a restart, the row under the kept block.
-  Matrix V = Matrix::Zero(size, m + 1);
-  Matrix G = Matrix::Zero(m + 1, m);
+  // Block Krylov-Schur: apply() takes `block` columns at a time (a caller can spread them over
+  // threads). The relation A V_j = V_j G_j + V_next E, E nonzero in its last block of columns
+  // only (the triangular factor of the last block's QR) except, after a restart, under the kept
+  // columns. One column (the default) is the usual Arnoldi relation A V_j = V_j G_j + g v e_j^T.
+  // At most m − wanted, so that a restart keeps the wanted columns and still grows by a block;
+  // and one column where the basis and a block would not fit in the space side by side (the last
+  // block would run out of directions: plain Arnoldi ends there on an invariant subspace).
+  const int b = size >= static_cast<Index>(m) + options.block
+                    ? std::max(1, std::min(options.block, m - wanted))
+                    : 1;
+  Matrix V = Matrix::Zero(size, m + b);
+  Matrix G = Matrix::Zero(m + b, m);
   V.col(0) = start / start.norm();
+  // The other starting columns: fixed random vectors, orthonormal to the first.
+  for (int c = 1; c < b; ++c) {
+    Vector extra(size);
+    for (Index i = 0; i < size; ++i) extra(i) = normal(rng);
+    for (int pass = 0; pass < 2; ++pass) extra -= V.leftCols(c) * (V.leftCols(c).transpose() * extra);
+    V.col(c) = extra / extra.norm();
+  }
   int kept = 0;  // columns carried over from the last cycle
-  Matrix w(size, 1);
-  Vector h(m + 1);
+  Matrix W(size, b);
   for (int restart = 0; restart <= options.max_restarts; ++restart) {
-    int built = m;
-    for (int j = kept; j < m; ++j) {
-      w = V.col(j);
-      apply(w);
+    int built = kept;  // columns whose products are in G
+    bool invariant = false;
+    for (int j = kept; j + b <= m; j += b) {
+      W = V.middleCols(j, b);
+      apply(W);
       // Classical Gram-Schmidt, twice: as orthogonal to rounding as modified Gram-Schmidt
       // twice ("twice is enough": L. Giraud, J. Langou, M. Rozloznik, Comput. Math. Appl. 50
-      // (2005) 1069-1075), in two matrix-vector products with the basis instead of 2(j + 1)
-      // dot products and updates one column at a time.
-      const auto basis = V.leftCols(j + 1);
-      for (int pass = 0; pass < 2; ++pass) {
-        h.head(j + 1).noalias() = basis.transpose() * w.col(0);
-        G.col(j).head(j + 1) += h.head(j + 1);
-        w.col(0).noalias() -= basis * h.head(j + 1);
+      // (2005) 1069-1075), in two products with the basis instead of 2(j + 1) dot products and
+      // updates one column at a time. Column by column: matrix-vector products stream the basis
+      // once each, where a matrix product would first copy it into packed panels.
+      // The columns of a block are independent here: on threads of their own when the basis
+      // is large (the same arithmetic per column on any number of threads).
+      const auto basis = V.leftCols(j + b);
+      const bool spread = b > 1 && size * (j + b) >= 100000;
+#pragma omp parallel for num_threads(b) if (spread)
+      for (int c = 0; c < b; ++c) {
+        Vector hc(j + b);
+        for (int pass = 0; pass < 2; ++pass) {
+          hc.noalias() = basis.transpose() * W.col(c);
+          G.col(j + c).head(j + b) += hc;
+          W.col(c).noalias() -= basis * hc;
+        }
       }
-      const double beta = w.col(0).norm();
-      G(j + 1, j) = beta;
-      if (beta <= 1e-14 * G.col(j).head(j + 1).norm() || j + 1 == size) {
-        built = j + 1;  // an invariant subspace: its Ritz values are exact
+      // The new block's QR, column by column (Gram-Schmidt twice again): R under the block.
+      for (int c = 0; c < b; ++c) {
+        for (int pass = 0; pass < 2; ++pass) {
+          for (int d = 0; d < c; ++d) {
+            const double r = V.col(j + b + d).dot(W.col(c));
+            G(j + b + d, j + c) += r;
+            W.col(c) -= r * V.col(j + b + d);
+          }
+        }
+        const double beta = W.col(c).norm();
+        G(j + b + c, j + c) = beta;
+        if (beta <= 1e-14 * G.col(j + c).head(j + b + c).norm()) invariant = true;
+        if (!invariant) V.col(j + b + c) = W.col(c) / beta;
+      }
+      built = j + b;
+      if (invariant || j + b >= size) {
+        invariant = true;  // an invariant subspace: its Ritz values are exact
         break;
       }
-      V.col(j + 1) = w.col(0) / beta;
     }
     const Matrix Gm = G.topLeftCorner(built, built);
     Eigen::EigenSolver<Matrix> eig(Gm);
@@ -137,15 +176,15 @@ FloquetMultipliers leading_floquet_multipliers(const std::function<void(Matrix&)
     const Eigen::MatrixXcd ritz_vectors = eig.eigenvectors();
     std::vector<int> order(built);
     for (int i = 0; i < built; ++i) order[i] = i;
-    std::sort(order.begin(), order.end(), [&](int a, int b) {
-      return std::abs(eig.eigenvalues()(a)) > std::abs(eig.eigenvalues()(b));
+    std::sort(order.begin(), order.end(), [&](int x, int y) {
+      return std::abs(eig.eigenvalues()(x)) > std::abs(eig.eigenvalues()(y));
     });
-    // Residual of the Ritz pair (θ, V s): |g| |s_last| / |s|, g the last Arnoldi step's.
-    const double beta = built < G.rows() ? G(built, built - 1) : 0.0;
+    // Residual of the Ritz pair (θ, V s): |E s| / |s|, E the rows under G (the last block's R).
+    const Matrix E = G.block(built, built - b, b, b);
     const double scale = std::max(1.0, std::abs(eig.eigenvalues()(order[0])));
     const auto residual_of = [&](int i) {
       const Eigen::VectorXcd s = ritz_vectors.col(i);
-      return std::abs(beta) * std::abs(s(built - 1)) / s.norm() / scale;
+      return (E * s.tail(b)).norm() / s.norm() / scale;
     };
     double worst = 0;
     int reported = std::min(wanted, built);
@@ -170,15 +209,15 @@ FloquetMultipliers leading_floquet_multipliers(const std::function<void(Matrix&)
         vectors->col(r) /= vectors->col(r).norm();
       }
     }
-    if (worst <= options.tolerance || built < m || restart == options.max_restarts) break;
+    if (worst <= options.tolerance || invariant || restart == options.max_restarts) break;
 
     // Thick restart (G. W. Stewart, SIAM J. Matrix Anal. Appl. 23 (2001) 601-614, Krylov-Schur;
     // R. B. Morgan, Math. Comp. 65 (1996) 1213-1230): keep the span of the leading Ritz vectors,
     // more of them than wanted, so that what the cycle learnt about the next ones is not thrown
     // away. A real basis Z of that span (a complex pair gives its real and imaginary parts), Q
     // its orthonormal basis: V Q spans an invariant subspace of the projected operator, with
-    // A (V Q) = (V Q) (Qᵀ G Q) + g v_{m+1} (e_mᵀ Q).
-    int keep = std::min(m - 1, std::max(wanted + (m - wanted) / 2, wanted));
+    // A (V Q) = (V Q) (Qᵀ G Q) + V_next (E_full Q), E_full the rows under G.
+    int keep = std::min(m - b, std::max(wanted + (m - wanted) / 2, wanted));
     Matrix Z(built, keep);
     int columns = 0;
     for (int r = 0; r < built && columns < keep; ++r) {
@@ -197,14 +236,14 @@ FloquetMultipliers leading_floquet_multipliers(const std::function<void(Matrix&)
     const Matrix Q = qr.householderQ() * Matrix::Identity(built, columns);
     const Matrix kept_basis = V.leftCols(built) * Q;
     const Matrix projected = Q.transpose() * Gm * Q;
-    const Vector next = V.col(built);
-    const Eigen::RowVectorXd coupling = beta * Q.row(built - 1);
+    const Matrix next = V.middleCols(built, b);
+    const Matrix coupling = G.block(built, 0, b, built) * Q;
     V.setZero();
     G.setZero();
     V.leftCols(columns) = kept_basis;
-    V.col(columns) = next;
+    V.middleCols(columns, b) = next;
     G.topLeftCorner(columns, columns) = projected;
-    G.row(columns).head(columns) = coupling;
+    G.block(columns, 0, b, columns) = coupling;
     kept = columns;
     if (!V.allFinite()) break;
   }

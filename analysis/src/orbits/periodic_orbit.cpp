@@ -81,9 +81,10 @@ FloquetMultipliers orbit_multipliers(StroboscopicMap& map, const Vector& state,
     if (monodromy != nullptr) *monodromy = std::move(M);
     return mu;
   }
+  ArnoldiOptions arnoldi = options.arnoldi;
+  arnoldi.block = map.tangent_block();
   return leading_floquet_multipliers(
-      [&](Matrix& v) { map.advance(state, options.period, v); }, map.state_size(),
-      options.arnoldi);
+      [&](Matrix& v) { map.advance(state, options.period, v); }, map.state_size(), arnoldi);
 }
 
 namespace {

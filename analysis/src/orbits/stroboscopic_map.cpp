@@ -1,6 +1,9 @@
 #include "pwl/orbits/stroboscopic_map.hpp"
 
+#include <omp.h>
+
 #include <cmath>
+#include <exception>
 #include <fmt/format.h>
 #include <limits>
 
@@ -23,13 +26,71 @@ StroboscopicMap::StroboscopicMap(const analysis::PointCase& point, const MethodS
   if (recording_) integrator_->record_tangent(true);
 }
 
+StroboscopicMap::StroboscopicMap(const StroboscopicMap& primary, Twin)
+    : point_(primary.point_),
+      settings_(primary.settings_),
+      steps_per_period_(primary.steps_per_period_) {
+  integrator_ = make_integrator(point_.structure, settings_);
+  recording_ = integrator_->can_record_tangent();
+  if (recording_) integrator_->record_tangent(true);
+}
+
 StroboscopicMap::~StroboscopicMap() = default;
 StroboscopicMap::StroboscopicMap(StroboscopicMap&&) noexcept = default;
 StroboscopicMap& StroboscopicMap::operator=(StroboscopicMap&&) noexcept = default;
 
 bool StroboscopicMap::exact_tangent() const { return integrator_->has_tangent_map(); }
 
+int StroboscopicMap::tangent_block() const {
+  return state_size() >= kSpreadStateSize && integrator_->can_record_tangent() ? 2 : 1;
+}
+
+bool StroboscopicMap::splits(const Matrix& tangent) const {
+  return tangent.cols() >= 2 && tangent_block() > 1 && omp_get_max_threads() > 1 &&
+         !omp_in_parallel();
+}
+
 Vector StroboscopicMap::integrate(const Vector& y, double t0, double t1, Matrix* tangent) {
+  if (tangent != nullptr && splits(*tangent)) return integrate_split(y, t0, t1, *tangent);
+  return integrate_here(y, t0, t1, tangent);
+}
+
+Vector StroboscopicMap::integrate_split(const Vector& y, double t0, double t1, Matrix& tangent) {
+  if (!twin_) twin_.reset(new StroboscopicMap(*this, Twin{}));
+  const Index second = tangent.cols() / 2, first = tangent.cols() - second;
+  Matrix head = tangent.leftCols(first), tail = tangent.rightCols(second);
+  Vector out;
+  std::exception_ptr errors[2];
+  // Exceptions (a motion that blows up) are carried out of the parallel region and rethrown,
+  // this map's first.
+#pragma omp parallel sections num_threads(2)
+  {
+#pragma omp section
+    {
+      try {
+        out = integrate_here(y, t0, t1, &head);
+      } catch (...) {
+        errors[0] = std::current_exception();
+      }
+    }
+#pragma omp section
+    {
+      try {
+        twin_->integrate_here(y, t0, t1, &tail);
+      } catch (...) {
+        errors[1] = std::current_exception();
+      }
+    }
+  }
+  for (const std::exception_ptr& e : errors) {
+    if (e) std::rethrow_exception(e);
+  }
+  tangent.leftCols(first) = head;
+  tangent.rightCols(second) = tail;
+  return out;
+}
+
+Vector StroboscopicMap::integrate_here(const Vector& y, double t0, double t1, Matrix* tangent) {
   const Index n = dofs();
   if (y.size() != 2 * n) {
     throw InputError(fmt::format("state has {} components, the structure needs {}", y.size(),

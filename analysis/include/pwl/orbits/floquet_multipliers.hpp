@@ -61,6 +61,10 @@ struct ArnoldiOptions {
   int max_restarts = 10;
   double tolerance = 1e-10;  // residual of a Ritz pair relative to max(|μ_1|, 1)
   unsigned seed = 1;         // the starting vector (fixed: the answer is reproducible)
+  // Columns per call of the operator (block Krylov-Schur): the basis grows by `block` products
+  // at a time, which a caller can spread over threads (StroboscopicMap does). 1: plain Arnoldi.
+  // At most krylov_dimension − count are used.
+  int block = 1;
   bool is_valid(std::string* why) const;
 };
 

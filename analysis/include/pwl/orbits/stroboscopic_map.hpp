@@ -29,6 +29,15 @@
 // product after Newton's line search has accepted a state is a replay of the line search's own
 // integration (plain integrations are recorded over at most 64 forcing periods). Another state or
 // span, or a caller that takes the integrator, ends the record.
+//
+// Products of several columns on two threads. From kSpreadStateSize state components on, a
+// product of several columns is split in two halves, the second applied by a second integrator of
+// the same structure (built on first use) in parallel with the first (where OpenMP has more than
+// one thread and the call is not already inside a parallel region). The second integrator records
+// the same arc once and replays it as the first does; every column goes through the same
+// arithmetic on either, so the products are the same to the last bit on any number of threads.
+// A block Krylov method (Arnoldi with ArnoldiOptions::block = tangent_block()) is what hands the
+// map two columns at a time.
 #include <functional>
 #include <memory>
 
@@ -59,6 +68,12 @@ class StroboscopicMap {
   int steps_per_period() const { return steps_per_period_; }
   // Whether tangent products are exact (the method's tangent map) or forward differences.
   bool exact_tangent() const;
+  // Columns worth handing to one tangent product: 2 where products of several columns are split
+  // over two integrators (recorded tangent maps, at least kSpreadStateSize state components), 1
+  // elsewhere. Fixed by the structure, not by the threads of the machine, so that a block
+  // method's answer is the same everywhere.
+  int tangent_block() const;
+  static constexpr Index kSpreadStateSize = 1000;
 
   // The state `periods` forcing periods after y: φ_{kT}(y), started at t = start_period · T. Loads
   // are T-periodic, so the start period changes nothing but the clock; it is there so that the
@@ -92,7 +107,15 @@ class StroboscopicMap {
   long tangent_replays() const { return replays_; }
 
  private:
+  struct Twin {};
+  // A second map of the same structure and settings (the other half of a split product).
+  StroboscopicMap(const StroboscopicMap& primary, Twin);
   Vector integrate(const Vector& y, double t0, double t1, Matrix* tangent);
+  // integrate() on this map's own integrator only.
+  Vector integrate_here(const Vector& y, double t0, double t1, Matrix* tangent);
+  // integrate() with the tangent's columns split between this map and its twin, in parallel.
+  Vector integrate_split(const Vector& y, double t0, double t1, Matrix& tangent);
+  bool splits(const Matrix& tangent) const;
 
   analysis::PointCase point_;
   MethodSettings settings_;
@@ -108,6 +131,7 @@ class StroboscopicMap {
   bool replay_ready_ = false;
   Vector base_start_, base_end_;
   double base_t0_ = 0.0, base_t1_ = 0.0;
+  std::unique_ptr<StroboscopicMap> twin_;  // built on the first split product
 };
 
 }  // namespace pwl::orbits
