@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
+#include <omp.h>
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
@@ -139,8 +140,9 @@ FloquetMultipliers leading_floquet_multipliers(const std::function<void(Matrix&)
       // The columns of a block are independent here: on threads of their own when the basis
       // is large (the same arithmetic per column on any number of threads).
       const auto basis = V.leftCols(j + b);
-      const bool spread = b > 1 && size * (j + b) >= 100000;
-#pragma omp parallel for num_threads(b) if (spread)
+      const int threads = std::min(b, omp_get_max_threads());
+      const bool spread = threads > 1 && !omp_in_parallel() && size * (j + b) >= 100000;
+#pragma omp parallel for num_threads(threads) if (spread)
       for (int c = 0; c < b; ++c) {
         Vector hc(j + b);
         for (int pass = 0; pass < 2; ++pass) {
