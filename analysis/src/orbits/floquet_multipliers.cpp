@@ -24,6 +24,20 @@ void sort_multipliers(std::vector<std::complex<double>>& values) {
                    });
 }
 
+// x minus its projection on the orthonormal columns of `basis`, the coefficients added to h, by
+// classical Gram-Schmidt twice: as orthogonal to rounding as modified Gram-Schmidt twice ("twice
+// is enough": L. Giraud, J. Langou, M. Rozloznik, Comput. Math. Appl. 50 (2005) 1069-1075), in
+// two matrix-vector products with the basis a pass instead of a dot product and an update per
+// column.
+template <class Basis, class Column, class Coefficients>
+void project_out_twice(const Basis& basis, Column&& x, Coefficients&& h) {
+  for (int pass = 0; pass < 2; ++pass) {
+    const Vector c = basis.transpose() * x;
+    h += c;
+    x.noalias() -= basis * c;
+  }
+}
+
 }  // namespace
 
 double FloquetMultipliers::largest_modulus() const {
@@ -121,7 +135,8 @@ FloquetMultipliers leading_floquet_multipliers(const std::function<void(Matrix&)
   for (int c = 1; c < b; ++c) {
     Vector extra(size);
     for (Index i = 0; i < size; ++i) extra(i) = normal(rng);
-    for (int pass = 0; pass < 2; ++pass) extra -= V.leftCols(c) * (V.leftCols(c).transpose() * extra);
+    Vector unused = Vector::Zero(c);
+    project_out_twice(V.leftCols(c), extra, unused);
     V.col(c) = extra / extra.norm();
   }
   int kept = 0;  // columns carried over from the last cycle
@@ -132,34 +147,18 @@ FloquetMultipliers leading_floquet_multipliers(const std::function<void(Matrix&)
     for (int j = kept; j + b <= m; j += b) {
       W = V.middleCols(j, b);
       apply(W);
-      // Classical Gram-Schmidt, twice: as orthogonal to rounding as modified Gram-Schmidt
-      // twice ("twice is enough": L. Giraud, J. Langou, M. Rozloznik, Comput. Math. Appl. 50
-      // (2005) 1069-1075), in two products with the basis instead of 2(j + 1) dot products and
-      // updates one column at a time. Column by column: matrix-vector products stream the basis
-      // once each, where a matrix product would first copy it into packed panels.
-      // The columns of a block are independent here: on threads of their own when the basis
-      // is large (the same arithmetic per column on any number of threads).
+      // Against the basis column by column (matrix-vector products stream the basis once
+      // each, where a matrix product would first copy it into packed panels). The columns of a
+      // block are independent here: on threads of their own when the basis is large (the same
+      // arithmetic per column on any number of threads).
       const auto basis = V.leftCols(j + b);
       const int threads = std::min(b, omp_get_max_threads());
       const bool spread = threads > 1 && !omp_in_parallel() && size * (j + b) >= 100000;
 #pragma omp parallel for num_threads(threads) if (spread)
+      for (int c = 0; c < b; ++c) project_out_twice(basis, W.col(c), G.col(j + c).head(j + b));
+      // The new block's QR, column by column: R under the block.
       for (int c = 0; c < b; ++c) {
-        Vector hc(j + b);
-        for (int pass = 0; pass < 2; ++pass) {
-          hc.noalias() = basis.transpose() * W.col(c);
-          G.col(j + c).head(j + b) += hc;
-          W.col(c).noalias() -= basis * hc;
-        }
-      }
-      // The new block's QR, column by column (Gram-Schmidt twice again): R under the block.
-      for (int c = 0; c < b; ++c) {
-        for (int pass = 0; pass < 2; ++pass) {
-          for (int d = 0; d < c; ++d) {
-            const double r = V.col(j + b + d).dot(W.col(c));
-            G(j + b + d, j + c) += r;
-            W.col(c) -= r * V.col(j + b + d);
-          }
-        }
+        project_out_twice(V.middleCols(j + b, c), W.col(c), G.col(j + c).segment(j + b, c));
         const double beta = W.col(c).norm();
         G(j + b + c, j + c) = beta;
         if (beta <= 1e-14 * G.col(j + c).head(j + b + c).norm()) invariant = true;
