@@ -183,29 +183,42 @@ void EventLocator::classify(const GapSample& a, const GapSample& b, bool* unknow
   }
 }
 
-// The earliest crossing among the springs judged "single" on [a, b], into `best`.
+// The earliest crossing among the springs judged "single" on [a, b], into `best`. Each of them
+// is refined on its own, evaluating that spring alone (at the earliest crossing found so far, a
+// spring still positive there crosses later and is passed over); the whole sample is taken once,
+// at the earliest crossing. When a step throws thousands of springs over their kinks at once (a
+// long chain far from its orbit) a whole sample per spring would make this quadratic in the
+// springs.
 void EventLocator::refine(const GapSample& a, const GapSample& b, GapSample& best) {
-  best = b;
+  double best_t = b.t;
   for (Index j = 0; j < m_; ++j) {
     if (verdict_[static_cast<std::size_t>(j)] != Verdict::single) continue;
-    if (best.e[j] > 0.0) continue;  // crosses after the best so far
-    if (a.e[j] <= 0.0) {            // already on the kink at a: the event is at a
+    double e = b.e[j], r = b.rate[j];
+    if (best_t != b.t) {
+      gaps_->sample_spring(a, best_t, j, &e, &r);
+      ++result_.samples;
+    }
+    if (e > 0.0) continue;  // crosses after the best so far
+    if (a.e[j] <= 0.0) {    // already on the kink at a: the event is at a
       best = a;
       return;
     }
-    refine_one(j, a, best);
+    best_t = refine_one(j, a, best_t, e, r);
+  }
+  if (best_t == b.t) {
+    best = b;
+  } else {
+    sample(a, best_t, best);
   }
 }
 
-// Newton's method on e_j, safeguarded by bisection, on a bracket with e_j(lo) > 0 >= e_j(hi),
-// evaluating spring j alone. Once the Newton correction is a few units in the last place, one
-// evaluation just past the estimated root closes the bracket from the crossed side; the whole
-// sample is taken there.
-void EventLocator::refine_one(Index j, const GapSample& a, GapSample& hi) {
+// Newton's method on e_j, safeguarded by bisection, on a bracket with e_j(lo) > 0 >= e_j(hi)
+// (hi at hi_t, where e_j = hi_e with rate hi_r), evaluating spring j alone. Once the Newton
+// correction is a few units in the last place, one evaluation just past the estimated root
+// closes the bracket from the crossed side. Returns the bracket's crossed end.
+double EventLocator::refine_one(Index j, const GapSample& a, double hi_t, double hi_e, double hi_r) {
   double lo_t = a.t, lo_e = a.e[j], lo_r = a.rate[j];
-  double hi_t = hi.t, hi_e = hi.e[j], hi_r = hi.rate[j];
   double previous_step = kInfinity;
-  bool moved = false;
   for (int k = 0; k < kMaxRefinements; ++k) {
     const double scale = std::max({std::abs(lo_t), std::abs(hi_t), s_->nominal_spacing});
     const double ulp = kEpsilon * scale;
@@ -233,10 +246,9 @@ void EventLocator::refine_one(Index j, const GapSample& a, GapSample& hi) {
       lo_t = t, lo_e = e, lo_r = r;
     } else {
       hi_t = t, hi_e = e, hi_r = r;
-      moved = true;
     }
   }
-  if (moved) sample(a, hi_t, hi);
+  return hi_t;
 }
 
 int EventLocator::certify_departure(ModeGaps& gaps, const GapSample& at, Index spring,

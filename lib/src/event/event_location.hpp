@@ -154,7 +154,7 @@ class EventLocator {
   double propose(const GapSample& a, double t_end);
   void classify(const GapSample& a, const GapSample& b, bool* unknown, bool* single);
   void refine(const GapSample& a, const GapSample& b, GapSample& best);
-  void refine_one(Index j, const GapSample& a, GapSample& hi);
+  double refine_one(Index j, const GapSample& a, double hi_t, double hi_e, double hi_r);
   GapSample& push();
   bool out_of_budget();
 
