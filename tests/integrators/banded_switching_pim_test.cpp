@@ -234,6 +234,64 @@ TEST_CASE("banded switching PIM: order d + 3 where no spring switches", "[banded
   CHECK(order > 2 + 2.5);
 }
 
+TEST_CASE("banded switching PIM: hundreds of springs close in one step, each at its own time",
+          "[banded][switching]") {
+  // 300 free unit masses (no springs between them, no damping), each with a gap spring to the
+  // ground (k = 100, Δ = 0), started at x0 = -v t* with velocity v so that spring i closes at its
+  // own time t*_i, all inside the first step (0.2 η to 0.8 η). In contact a mass moves as
+  // x = (v/ω) sin(ω (t - t*)), ω = 10, and none leaves its spring before t = 0.2 (half a contact
+  // is π/10 after t*). All 300 closures are located in the one step: the root search has every
+  // one of them on its list at once and must take the earliest each time. Against the closed
+  // form (to the method's own error: order d + 3 = 5 with ηω = 0.05, about 1e-11), and against
+  // the same masses integrated one at a time, each with its single closure (to rounding).
+  const int n = 300;
+  const double k = 100.0, omega = 10.0, eta = 0.005, t_end = 0.2;
+  const auto free_masses = [](int count) {
+    GapStructure s;
+    s.mass = to_sparse(Matrix::Identity(count, count));
+    s.damping = to_sparse(Matrix::Zero(count, count));
+    s.stiffness = to_sparse(Matrix::Zero(count, count));
+    return s;
+  };
+  GapStructure s = free_masses(n);
+  Vector x0(n), v0(n), closes(n), x_true(n), v_true(n);
+  for (int i = 0; i < n; ++i) {
+    s.springs.push_back({i, -1, 1.0, k, 0.0});
+    // Distinct times (multiples of the golden ratio modulo 1 spread them over the interval).
+    closes[i] = eta * (0.2 + 0.6 * std::fmod(0.6180339887498949 * (i + 1), 1.0));
+    v0[i] = 1.0 + 0.5 * std::sin(0.9 * i);
+    x0[i] = -v0[i] * closes[i];
+    const double phase = omega * (t_end - closes[i]);
+    x_true[i] = v0[i] / omega * std::sin(phase);
+    v_true[i] = v0[i] * std::cos(phase);
+  }
+  auto pim = make_banded_switching_pim(s, banded_options(eta));
+  pim->set_state(0.0, x0, v0);
+  pim->advance_to(eta);
+  CHECK(pim->diagnostics().switches == n);
+  CHECK(pim->diagnostics().pieces == n + 1);
+  pim->advance_to(t_end);
+  CHECK(pim->diagnostics().switches == n);
+  const double error = std::max((pim->position() - x_true).cwiseAbs().maxCoeff(),
+                                (pim->velocity() - v_true).cwiseAbs().maxCoeff());
+  INFO("largest error against the closed form " << error);
+  CHECK(error < 1e-10);
+  double apart = 0.0;
+  for (int i = 0; i < n; ++i) {
+    GapStructure one = free_masses(1);
+    one.springs.push_back({0, -1, 1.0, k, 0.0});
+    SwitchingPimOptions o;
+    o.step = eta;
+    auto alone = make_switching_pim(one, o);
+    alone->set_state(0.0, Vector::Constant(1, x0[i]), Vector::Constant(1, v0[i]));
+    alone->advance_to(t_end);
+    apart = std::max({apart, std::abs(alone->position()[0] - pim->position()[i]),
+                      std::abs(alone->velocity()[0] - pim->velocity()[i])});
+  }
+  INFO("largest difference from the masses integrated one at a time " << apart);
+  CHECK(apart < 1e-12);
+}
+
 TEST_CASE("banded switching PIM: bad input names the field", "[banded][switching]") {
   const GapStructure s = make_chain(paper_large_chain(60));
   BandedSwitchingPimOptions o;
