@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <complex>
+#include <limits>
 #include <random>
 #include <tuple>
 #include <vector>
@@ -266,6 +267,84 @@ TEST_CASE("thick-restarted Arnoldi resolves long-wave multipliers crowded agains
   measured("crowded multipliers, 60 vectors: residual", small.residual);
   measured("crowded multipliers, 60 vectors: products", static_cast<double>(products));
   CHECK_FALSE(small.converged);
+}
+
+TEST_CASE("Arnoldi reports every multiplier in a band round the unit circle, or says it did not",
+          "[orbits]") {
+  // A = S D S⁻¹ of size 400 with a crowd against the circle, μ_k = (1 − 4e-5 k²) e^{±0.03 k i}
+  // for k = 1 .. 100, the other 200 in a disc of radius 0.5. Asked for six with a margin of 0.01
+  // (the band |μ| > 0.99 holds the 15 pairs k <= 15), Arnoldi must double its count until the
+  // band is covered and report all 30; with a margin of 0.2 (70 pairs) half its basis of 200 does
+  // not reach below the band, and it must say so. With five pairs pushed outside the circle and
+  // no margin, all ten outside must be reported (the continuation's rule for its stability).
+  const Index n = 400;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const auto crowd = [&](double outside_scale) {
+    Matrix D = Matrix::Zero(n, n);
+    std::vector<Complex> all;
+    for (int k = 1; k <= 100; ++k) {
+      const double r = (1.0 - 4e-5 * k * k) * (k <= 5 ? outside_scale : 1.0), phi = 0.03 * k;
+      put_pair(D, 2 * (k - 1), r, phi);
+      all.push_back(std::polar(r, phi));
+      all.push_back(std::polar(r, -phi));
+    }
+    for (Index i = 200; i + 1 < n; i += 2) put_pair(D, i, 0.5 * std::abs(u(rng)), 3.2 * u(rng));
+    return std::make_pair(similar_to(D, rng), all);
+  };
+  const auto in_band = [](const std::vector<Complex>& values, double edge) {
+    std::vector<Complex> out;
+    for (const Complex& mu : values) {
+      if (std::abs(mu) > edge) out.push_back(mu);
+    }
+    return out;
+  };
+  // Every value of `wanted` has one within 1e-9 among `found`.
+  const auto all_found = [](const std::vector<Complex>& wanted, const std::vector<Complex>& found) {
+    double worst = 0.0;
+    for (const Complex& w : wanted) {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (const Complex& f : found) nearest = std::min(nearest, std::abs(f - w));
+      worst = std::max(worst, nearest);
+    }
+    return worst;
+  };
+  ArnoldiOptions options;
+  options.count = 6;
+  {
+    const auto [A, all] = crowd(1.0);
+    const auto apply = [&A](Matrix& v) { v = A * v; };
+    options.margin = 0.01;
+    const FloquetMultipliers band = leading_floquet_multipliers(apply, n, options);
+    const std::vector<Complex> wanted = in_band(all, 0.99);
+    REQUIRE(wanted.size() == 30);
+    CHECK(band.converged);
+    CHECK(band.band_covered);
+    CHECK(band.values.size() >= wanted.size());
+    CHECK(std::abs(band.values.back()) <= 0.99);
+    const double worst = all_found(wanted, band.values);
+    measured("band of 0.01: farthest multiplier of the band from a reported one", worst);
+    CHECK(worst <= 1e-9);
+
+    options.margin = 0.2;
+    const FloquetMultipliers wide = leading_floquet_multipliers(apply, n, options);
+    REQUIRE(in_band(all, 0.8).size() == 140);
+    CHECK_FALSE(wide.band_covered);
+    CHECK(wide.values.size() < 140);
+    CHECK(std::abs(wide.values.back()) > 0.8);
+  }
+  {
+    const auto [A, all] = crowd(1.01);
+    const auto apply = [&A](Matrix& v) { v = A * v; };
+    options.margin = 0.0;
+    const FloquetMultipliers found = leading_floquet_multipliers(apply, n, options);
+    const std::vector<Complex> outside = in_band(all, 1.0);
+    REQUIRE(outside.size() == 10);
+    CHECK(found.converged);
+    CHECK(found.band_covered);
+    CHECK(found.unstable_count() == 10);
+    CHECK(all_found(outside, found.values) <= 1e-9);
+  }
 }
 
 TEST_CASE(

@@ -3,7 +3,8 @@
 // same branch of a 150-mass chain, whose period-1 orbit loses stability at two Neimark–Sacker
 // points below θ = 0.74, past grazings: the same bifurcations, located to within 1e-8 of each
 // other, the same stability at every point, and the leading multipliers at its points equal to
-// the eigenvalues of the monodromy formed there. (Release build only: 22 s there.)
+// the eigenvalues of the monodromy formed there, every one of them in the band |μ| > 0.99 among
+// the reported (ArnoldiOptions::margin). (Release build only: 43 s there.)
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <complex>
@@ -31,6 +32,9 @@ TEST_CASE("the 150-mass chain's branch is the same matrix-free as dense", "[orbi
   o.method = method;
   o.steps_per_period = 200;
   o.max_points = 200;
+  // Arnoldi covers the band |μ| > 0.99 at every matrix-free point (the dense monodromy has all).
+  const double margin = 0.01;
+  o.shooting.arnoldi.margin = margin;
   const ContinuationResult dense = follow(chain, guess, o, ShootingSolver::dense);
   const ContinuationResult free = follow(chain, guess, o, ShootingSolver::krylov);
   REQUIRE_FALSE(dense.matrix_free);
@@ -82,8 +86,10 @@ TEST_CASE("the 150-mass chain's branch is the same matrix-free as dense", "[orbi
     CHECK_FALSE(p.orbit.multipliers.complete);
   }
 
-  // The leading multipliers at three points equal the eigenvalues of the monodromy formed there.
-  double distance = 0;
+  // The leading multipliers at three points equal the eigenvalues of the monodromy formed there,
+  // and every eigenvalue in the band is among them.
+  double distance = 0, band = 0;
+  std::size_t widest = 0;
   for (const std::size_t i : {std::size_t{0}, free.points.size() / 2, free.points.size() - 1}) {
     const BranchPoint& p = free.points[i];
     StroboscopicMap map(analysis::PointCase(paper_chain(150, p.parameter)), method, 200);
@@ -95,7 +101,24 @@ TEST_CASE("the 150-mass chain's branch is the same matrix-free as dense", "[orbi
     const std::vector<std::complex<double>> expected(all.values.begin(),
                                                      all.values.begin() + leading.size());
     distance = std::max(distance, pwl::test::set_distance(expected, leading));
+    CHECK(p.orbit.multipliers.band_covered);
+    std::size_t in_band = 0;
+    for (const std::complex<double>& mu : all.values) {
+      if (std::abs(mu) <= 1.0 - margin) continue;
+      ++in_band;
+      double nearest = 1.0;
+      for (const std::complex<double>& f : leading) nearest = std::min(nearest, std::abs(f - mu));
+      band = std::max(band, nearest);
+    }
+    CHECK(leading.size() >= in_band);
+    widest = std::max(widest, in_band);
   }
   measured("150 masses: leading multipliers against the monodromy's eigenvalues", distance);
+  measured("150 masses: farthest eigenvalue of the band |mu| > 0.99 from a reported multiplier",
+           band);
+  measured("150 masses: most eigenvalues in the band at one of the three points",
+           static_cast<double>(widest));
   CHECK(distance <= 1e-8);
+  CHECK(band <= 1e-8);
+  CHECK(widest > 6);  // more than Arnoldi's default count: the band made it report them
 }

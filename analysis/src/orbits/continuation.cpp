@@ -367,34 +367,21 @@ class Continuer {
 
   // Matrix-free: the leading multipliers of the orbit at pt and their Ritz vectors, by
   // thick-restarted Arnoldi warm-started from `warm` (a point nearby): at least the options'
-  // count, and more (doubled) while every one of them lies outside the unit circle and Arnoldi
-  // converged, so that all those outside are among them.
+  // count, and every one in the band of the options' margin (by default: every one outside the
+  // unit circle).
   void leading_multipliers(Point& pt, int period, const Eigen::MatrixXcd* warm) {
     StroboscopicMap& map = map_at(pt.p());
     const Vector y = pt.y();
     ArnoldiOptions arnoldi = options_.shooting.arnoldi;
     arnoldi.block = map.tangent_block();
-    Eigen::MatrixXcd start;
-    if (warm != nullptr) start = *warm;
-    while (true) {
-      pt.mu = leading_floquet_multipliers(
-          [&](Matrix& v) {
-            map.advance(y, period, v);
-            result_.arnoldi_products += v.cols();
-          },
-          y.size(), arnoldi, start.size() > 0 ? &start : nullptr, &pt.ritz);
-      const bool all_outside = !pt.mu.values.empty() && std::abs(pt.mu.values.back()) > 1.0;
-      // Only converged values are worth more of them: Ritz values short of their tolerance can sit
-      // outside the circle with nothing there (a 10^4-mass chain's crowded long waves: 1.00007
-      // at a residual of 3e-2), and each doubling would be another whole unconverged Arnoldi.
-      if (!all_outside || !pt.mu.converged || pt.mu.complete ||
-          2 * arnoldi.count >= arnoldi.krylov_dimension) {
-        break;
-      }
-      arnoldi.count *= 2;
-      start = pt.ritz;
-    }
+    pt.mu = leading_floquet_multipliers(
+        [&](Matrix& v) {
+          map.advance(y, period, v);
+          result_.arnoldi_products += v.cols();
+        },
+        y.size(), arnoldi, warm != nullptr && warm->size() > 0 ? warm : nullptr, &pt.ritz);
     if (!pt.mu.converged) ++result_.unconverged_multipliers;
+    if (pt.mu.converged && !pt.mu.band_covered) ++result_.uncovered_bands;
   }
 
   // Matrix-free corrector: Newton on F(y, p) = 0 with τ · (u − prediction) = 0 from `guess`, each

@@ -438,6 +438,11 @@ void continue_orbit(const ContinueFlags& f) {
                  "unconverged Ritz values\n",
                  result.unconverged_multipliers);
     }
+    if (result.uncovered_bands > 0) {
+      fmt::print("  at {} point(s) Arnoldi's multipliers stopped at half its basis still above {:.6g} "
+                 "in modulus: more of them may lie there than were reported\n",
+                 result.uncovered_bands, 1.0 - c.shooting.arnoldi.margin);
+    }
   } else {
     fmt::print("work: {} monodromies, {} other integrations of the map; {} step(s) cut to explain "
                "the multipliers' signature\n",

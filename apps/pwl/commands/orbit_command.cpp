@@ -129,8 +129,20 @@ void orbit(const OrbitCommandFlags& f) {
                "multipliers outside the unit circle)\n",
                mu.residual, outside);
   } else {
-    fmt::print("verdict: {} ({} multiplier{} outside the unit circle)\n",
-               orbit.stable() ? "stable" : "unstable", outside, outside == 1 ? "" : "s");
+    // Arnoldi's count doubles until its smallest multiplier lies below 1 − margin; where it
+    // stopped at half its basis first, those outside may be more than it reports.
+    const double margin = problem.shooting.arnoldi.margin;
+    std::string band;
+    if (!mu.complete && mu.band_covered && margin > 0) {
+      band = fmt::format("; every multiplier above {:.6g} in modulus is among the {}", 1 - margin,
+                         mu.values.size());
+    } else if (!mu.band_covered) {
+      band = fmt::format("; more may lie above {:.6g} in modulus: Arnoldi stopped at {} of them",
+                         1 - margin, mu.values.size());
+    }
+    fmt::print("verdict: {} ({}{} multiplier{} outside the unit circle{})\n",
+               orbit.stable() ? "stable" : "unstable", mu.band_covered ? "" : "at least ",
+               outside, outside == 1 ? "" : "s", band);
   }
   fmt::print("time: {:.3f} s\n", seconds);
   fmt::print("wrote {0}/orbit.csv, {0}/floquet.csv{1}\n", o.out,

@@ -62,6 +62,10 @@ void add_orbit_flags(CLI::App& c, OrbitFlags& f, bool with_dt) {
                "Guess: the state in this CSV file instead (header x1..xn,v1..vn, e.g. an\n"
                "orbit.csv; the last row is read, a leading column such as t is skipped)")
       ->check(CLI::ExistingFile);
+  c.add_option("--multiplier-margin", f.multiplier_margin,
+               "Krylov: Arnoldi reports every Floquet multiplier of modulus above 1 − this\n"
+               "(its count doubles until the smallest is below); 0: those outside the circle")
+      ->check(number_check({0.0, 1.0, false, true, "a number in [0, 1)"}, "[0,1)"));
   c.add_option("--out", f.out, "Output folder");
   c.add_flag("--quiet", f.quiet, "No progress on standard error");
 }
@@ -179,6 +183,10 @@ void check_orbit_flags(const OrbitFlags& f) {
     throw InputError(fmt::format("--max-iterations = {} must be >= 1", f.max_iterations));
   }
   if (f.transient < 0) throw InputError(fmt::format("--transient = {} must be >= 0", f.transient));
+  if (!(f.multiplier_margin >= 0 && f.multiplier_margin < 1)) {
+    throw InputError(
+        fmt::format("--multiplier-margin = {} must be in [0, 1)", f.multiplier_margin));
+  }
 }
 
 orbits::ShootingOptions shooting_options(const OrbitFlags& f) {
@@ -186,6 +194,7 @@ orbits::ShootingOptions shooting_options(const OrbitFlags& f) {
   s.period = f.period;
   s.tolerance = f.newton_tolerance;
   s.max_iterations = f.max_iterations;
+  s.arnoldi.margin = f.multiplier_margin;
   return s;
 }
 

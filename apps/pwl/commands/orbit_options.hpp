@@ -22,6 +22,7 @@ struct OrbitFlags {
   double newton_tolerance = 1e-10;
   int max_iterations = 40;
   int transient = 200;         // forcing periods from rest before the guess is taken
+  double multiplier_margin = 0.0;  // Arnoldi reports every multiplier with |μ| > 1 − this
   std::string guess_file;      // a state file instead of the transient
   std::string out = "orbit";
   bool quiet = false;
@@ -29,7 +30,7 @@ struct OrbitFlags {
 
 // The case flags (add_case_options, without --periods and --skip-periods, which an orbit does not
 // use, and without --dt unless `with_dt`), --period, --newton-tol, --max-iterations, --transient,
-// --guess-file, --out and --quiet. --method's default becomes the orbit default (orbit_method).
+// --guess-file, --multiplier-margin, --out and --quiet. --method's default becomes the orbit default (orbit_method).
 void add_orbit_flags(CLI::App& command, OrbitFlags& flags, bool with_dt);
 // To be called from the command's callback: records whether --method was given.
 void read_method_given(const CLI::App& command, OrbitFlags& flags);

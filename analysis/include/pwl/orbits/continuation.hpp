@@ -177,6 +177,10 @@ struct ContinuationResult {
   long krylov_products = 0;
   long arnoldi_products = 0;
   long unconverged_multipliers = 0;
+  // Matrix-free: the points whose converged multipliers did not reach below the band of
+  // ArnoldiOptions::margin within half Arnoldi's basis (more may lie in it, outside the circle
+  // with margin 0, than were reported).
+  long uncovered_bands = 0;
   // Steps cut in two because the multipliers' signature changed in a way the events located in
   // them did not explain (several events in one step).
   long step_cuts = 0;
