@@ -30,7 +30,8 @@ struct OrbitFlags {
 
 // The case flags (add_case_options, without --periods and --skip-periods, which an orbit does not
 // use, and without --dt unless `with_dt`), --period, --newton-tol, --max-iterations, --transient,
-// --guess-file, --multiplier-margin, --out and --quiet. --method's default becomes the orbit default (orbit_method).
+// --guess-file, --multiplier-margin, --out and --quiet. --method's default becomes the orbit
+// default (orbit_method).
 void add_orbit_flags(CLI::App& command, OrbitFlags& flags, bool with_dt);
 // To be called from the command's callback: records whether --method was given.
 void read_method_given(const CLI::App& command, OrbitFlags& flags);
