@@ -379,7 +379,7 @@ class Continuer {
           map.advance(y, period, v);
           result_.arnoldi_products += v.cols();
         },
-        y.size(), arnoldi, warm != nullptr && warm->size() > 0 ? warm : nullptr, &pt.ritz);
+        y.size(), arnoldi, warm, &pt.ritz);
     if (!pt.mu.converged) ++result_.unconverged_multipliers;
     if (pt.mu.converged && !pt.mu.band_covered) ++result_.uncovered_bands;
   }

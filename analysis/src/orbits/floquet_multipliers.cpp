@@ -97,13 +97,13 @@ bool ArnoldiOptions::is_valid(std::string* why) const {
   return true;
 }
 
-namespace {
-
-// One thick-restarted (block) Krylov-Schur run for exactly options.count multipliers; the options
-// are valid and size >= 1.
-FloquetMultipliers krylov_schur(const std::function<void(Matrix&)>& apply, Index size,
-                                const ArnoldiOptions& options, const Eigen::MatrixXcd* warm,
-                                Eigen::MatrixXcd* vectors) {
+FloquetMultipliers leading_floquet_multipliers(const std::function<void(Matrix&)>& apply,
+                                               Index size, const ArnoldiOptions& options,
+                                               const Eigen::MatrixXcd* warm,
+                                               Eigen::MatrixXcd* vectors) {
+  std::string why;
+  if (!options.is_valid(&why)) throw InputError(why);
+  if (size < 1) throw InputError(fmt::format("operator size = {} must be >= 1", size));
   int wanted = static_cast<int>(std::min<Index>(options.count, size));
   const int m = static_cast<int>(std::min<Index>(options.krylov_dimension, size));
   const double edge = 1.0 - options.margin;  // the band |μ| > edge must be covered
@@ -268,6 +268,9 @@ FloquetMultipliers krylov_schur(const std::function<void(Matrix&)>& apply, Index
     if (!V.allFinite()) break;
   }
   result.converged = result.residual <= options.tolerance;
+  // The values are in decreasing modulus: the last is the smallest.
+  result.band_covered =
+      result.complete || (result.converged && std::abs(result.values.back()) <= edge);
   if (vectors == nullptr) {
     sort_multipliers(result.values);
     return result;
@@ -289,22 +292,6 @@ FloquetMultipliers krylov_schur(const std::function<void(Matrix&)>& apply, Index
   *vectors = std::move(arranged);
   result.values = std::move(sorted);
   return result;
-}
-
-}  // namespace
-
-FloquetMultipliers leading_floquet_multipliers(const std::function<void(Matrix&)>& apply,
-                                               Index size, const ArnoldiOptions& options,
-                                               const Eigen::MatrixXcd* warm,
-                                               Eigen::MatrixXcd* vectors) {
-  std::string why;
-  if (!options.is_valid(&why)) throw InputError(why);
-  if (size < 1) throw InputError(fmt::format("operator size = {} must be >= 1", size));
-  FloquetMultipliers mu = krylov_schur(apply, size, options, warm, vectors);
-  mu.band_covered =
-      mu.complete || (mu.converged && !mu.values.empty() &&
-                      std::abs(mu.values.back()) <= 1.0 - options.margin);
-  return mu;
 }
 
 }  // namespace pwl::orbits
