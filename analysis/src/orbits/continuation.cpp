@@ -125,6 +125,25 @@ double product_shifted(const FloquetMultipliers& mu, double target) {
   return product.real();
 }
 
+// How far the multipliers near the unit circle moved over a step: the largest distance from a
+// multiplier within half the margin of the circle at one end (||μ| − 1| <= margin / 2) to the
+// nearest multiplier at the other end. One that moved less than half the margin is, at the other
+// end, in the band |μ| > 1 − margin that Arnoldi reports whole, so its partner is there to be
+// found; a larger distance means that some multiplier moved more than half the margin (or that
+// the two ends' multipliers cannot be paired). 0 where no multiplier is near the circle.
+double band_movement(const FloquetMultipliers& a, const FloquetMultipliers& b, double margin) {
+  double largest = 0.0;
+  for (const auto& [from, to] : {std::pair{&a, &b}, std::pair{&b, &a}}) {
+    for (const auto& m : from->values) {
+      if (std::abs(std::abs(m) - 1.0) > 0.5 * margin) continue;
+      double nearest = std::numeric_limits<double>::infinity();
+      for (const auto& other : to->values) nearest = std::min(nearest, std::abs(m - other));
+      largest = std::max(largest, nearest);
+    }
+  }
+  return largest;
+}
+
 // A point of the branch: u = (y, p), and what was computed there.
 struct Point : CurvePoint {
   Matrix M;  // monodromy (empty where the corrector did not form it at the point)
@@ -536,6 +555,23 @@ class Continuer {
         }
       }
       return std::nullopt;
+    }
+
+    // With a band (ArnoldiOptions::margin > 0): a step over which a multiplier near the circle
+    // moved more than half the margin is cut, so that none goes out of the circle and back (or in
+    // and out) between two points unseen, as long as its path over a step is not bent by more
+    // than its distance from the circle at the ends: the disc is convex, so a multiplier that
+    // moves straight between two points inside it stays inside. Not where either end's band is
+    // not covered or its multipliers did not converge (nothing to pair them with).
+    bool too_long(const Point& from, const Point& to) override {
+      const double margin = c_.options_.shooting.arnoldi.margin;
+      if (!(margin > 0)) return false;
+      for (const Point* end : {&from, &to}) {
+        if (!end->mu.converged || !end->mu.band_covered) return false;
+      }
+      if (band_movement(from.mu, to.mu, margin) <= 0.5 * margin) return false;
+      ++c_.result_.band_cuts;
+      return true;
     }
 
     std::optional<std::string> accept(Point& from, Point& to, double h, int points) override {

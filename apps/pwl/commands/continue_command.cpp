@@ -448,6 +448,10 @@ void continue_orbit(const ContinueFlags& f) {
                "the multipliers' signature\n",
                result.monodromies, result.integrations, result.step_cuts);
   }
+  if (result.band_cuts > 0) {
+    fmt::print("  {} step(s) halved where a multiplier near the circle moved more than {:.6g}\n",
+               result.band_cuts, 0.5 * c.shooting.arnoldi.margin);
+  }
   fmt::print("time: {:.2f} s ({} points)\n", seconds, outputs.points());
   fmt::print("wrote {0}/branch.csv, {0}/branch_section.csv and {0}/bifurcations.csv\n", o.out);
   if (!f.no_plot) {

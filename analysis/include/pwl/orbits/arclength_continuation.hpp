@@ -19,7 +19,8 @@
 // about one Jacobian (at the point, where the problem wants it anyway) and a few evaluations of
 // G. The step grows after easy corrections (Newton: two iterations or fewer; chord: the corrected
 // point within 2e-4 of the prediction, relative to the state) and shrinks after hard ones, after
-// a failed correction, or a turn of the tangent by more than 30°.
+// a failed correction, a turn of the tangent by more than 30°, or where the problem finds that
+// something it watches moved too far in one step.
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -239,6 +240,11 @@ class CurveWalk {
                                                  int /*points*/) {
     return std::nullopt;
   }
+  // Whether the step from `from` to `to` moved something the problem watches further than one
+  // step may (a Floquet multiplier near the unit circle, which could have left it and come back
+  // unseen): the step is halved, as after a sharp turn of the tangent, down to four times the
+  // smallest step.
+  virtual bool too_long(const P& /*from*/, const P& /*to*/) { return false; }
   // Accepts `to`, the walk's point number `points`: the events between the two points, the
   // output. A reason returned stops the walk there, `to` not kept as the walk's last point.
   virtual std::optional<std::string> accept(P& from, P& to, double h, int points) = 0;
@@ -274,6 +280,10 @@ class CurveWalk {
         continue;
       }
       if (next->tangent.dot(current.tangent) < std::cos(30.0 * kPi / 180) && h > 4 * steps.min) {
+        h /= 2;
+        continue;
+      }
+      if (h > 4 * steps.min && too_long(current, *next)) {
         h /= 2;
         continue;
       }

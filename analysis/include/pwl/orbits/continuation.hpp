@@ -72,6 +72,13 @@
 // multipliers inside the circle) are all positive, so their sign changes exactly where the whole
 // determinant's does. Branch switching takes the Ritz vector of the multiplier −1. The chord
 // corrector is dense only.
+//
+// A band round the circle (ShootingOptions::arnoldi.margin > 0, dense or matrix-free): a step is
+// halved while a multiplier within half the margin of the circle at one end has none within half
+// the margin of it at the other, so that a multiplier does not leave the circle and come back (a
+// window of stability or instability shorter than a step, the same signature at both ends)
+// between two points unseen; see the head of BranchWalk::too_long in continuation.cpp for what
+// this rests on.
 #include <complex>
 #include <string>
 #include <vector>
@@ -181,6 +188,9 @@ struct ContinuationResult {
   // ArnoldiOptions::margin within half Arnoldi's basis (more may lie in it, outside the circle
   // with margin 0, than were reported).
   long uncovered_bands = 0;
+  // Steps halved because a multiplier near the unit circle moved more than half the band's
+  // margin (ArnoldiOptions::margin > 0 only; see the head of this file).
+  long band_cuts = 0;
   // Steps cut in two because the multipliers' signature changed in a way the events located in
   // them did not explain (several events in one step).
   long step_cuts = 0;
