@@ -12,6 +12,7 @@
 #include <set>
 
 #include "orbits/bordered_krylov.hpp"
+#include "orbits/multiplier_movement.hpp"
 #include "orbits/open_structure_preconditioner.hpp"
 
 namespace pwl::orbits {
@@ -123,25 +124,6 @@ double product_shifted(const FloquetMultipliers& mu, double target) {
   std::complex<double> product{1.0, 0.0};
   for (const auto& m : mu.values) product *= 1.0 - m / target;
   return product.real();
-}
-
-// How far the multipliers near the unit circle moved over a step: the largest distance from a
-// multiplier within half the margin of the circle at one end (||μ| − 1| <= margin / 2) to the
-// nearest multiplier at the other end. One that moved less than half the margin is, at the other
-// end, in the band |μ| > 1 − margin that Arnoldi reports whole, so its partner is there to be
-// found; a larger distance means that some multiplier moved more than half the margin (or that
-// the two ends' multipliers cannot be paired). 0 where no multiplier is near the circle.
-double band_movement(const FloquetMultipliers& a, const FloquetMultipliers& b, double margin) {
-  double largest = 0.0;
-  for (const auto& [from, to] : {std::pair{&a, &b}, std::pair{&b, &a}}) {
-    for (const auto& m : from->values) {
-      if (std::abs(std::abs(m) - 1.0) > 0.5 * margin) continue;
-      double nearest = std::numeric_limits<double>::infinity();
-      for (const auto& other : to->values) nearest = std::min(nearest, std::abs(m - other));
-      largest = std::max(largest, nearest);
-    }
-  }
-  return largest;
 }
 
 // A point of the branch: u = (y, p), and what was computed there.
@@ -557,19 +539,25 @@ class Continuer {
       return std::nullopt;
     }
 
-    // With a band (ArnoldiOptions::margin > 0): a step over which a multiplier near the circle
-    // moved more than half the margin is cut, so that none goes out of the circle and back (or in
-    // and out) between two points unseen, as long as its path over a step is not bent by more
-    // than its distance from the circle at the ends: the disc is convex, so a multiplier that
-    // moves straight between two points inside it stays inside. Not where either end's band is
-    // not covered or its multipliers did not converge (nothing to pair them with).
+    // With a band (ArnoldiOptions::margin > 0): a step is cut when a multiplier within half the
+    // margin of the circle at one end has no partner of its own within half the margin of it at
+    // the other (detail::band_stayed). What it catches: a multiplier near the circle that goes
+    // out and back (or in and out) within one step, the same signature at both ends, as long as
+    // its path over the step is not bent by more than its distance from the circle at the ends
+    // (the disc is convex: a multiplier that moves straight between two points inside stays
+    // inside; outside, the same holds while the step is short against the circle's curvature).
+    // What it does not: a multiplier farther than half the margin from the circle at both ends
+    // (two pairs that cross the circle in opposite directions within one step from outside the
+    // margin leave the signature as it was: a margin above the multipliers' movement in a step is
+    // the user's choice), and a step already at four times the smallest (the core stops cutting
+    // there). Not where either end's band is not covered or its multipliers did not converge.
     bool too_long(const Point& from, const Point& to) override {
       const double margin = c_.options_.shooting.arnoldi.margin;
       if (!(margin > 0)) return false;
       for (const Point* end : {&from, &to}) {
         if (!end->mu.converged || !end->mu.band_covered) return false;
       }
-      if (band_movement(from.mu, to.mu, margin) <= 0.5 * margin) return false;
+      if (detail::band_stayed(from.mu.values, to.mu.values, margin)) return false;
       ++c_.result_.band_cuts;
       return true;
     }

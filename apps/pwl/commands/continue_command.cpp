@@ -449,7 +449,8 @@ void continue_orbit(const ContinueFlags& f) {
                result.monodromies, result.integrations, result.step_cuts);
   }
   if (result.band_cuts > 0) {
-    fmt::print("  {} step(s) halved where a multiplier near the circle moved more than {:.6g}\n",
+    fmt::print("  {} step(s) halved where a multiplier within {:.6g} of the circle had no partner "
+               "that near it at the step's other end\n",
                result.band_cuts, 0.5 * c.shooting.arnoldi.margin);
   }
   fmt::print("time: {:.2f} s ({} points)\n", seconds, outputs.points());

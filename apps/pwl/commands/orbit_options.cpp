@@ -65,8 +65,9 @@ void add_orbit_flags(CLI::App& c, OrbitFlags& f, bool with_dt) {
   c.add_option("--multiplier-margin", f.multiplier_margin,
                "Krylov: Arnoldi reports every Floquet multiplier of modulus above 1 − this\n"
                "(its count doubles until the smallest is below); 0: those outside the circle.\n"
-               "continue: a step over which a multiplier near the circle moves more than half\n"
-               "this is halved, so none leaves the circle and comes back unseen")
+               "continue: a step is halved while a multiplier within half this of the circle has\n"
+               "no partner within half this at the step's other end (one to one), so that one\n"
+               "moving less than that in a step does not leave the circle and come back unseen")
       ->check(number_check({0.0, 1.0, false, true, "a number in [0, 1)"}, "[0,1)"));
   c.add_option("--out", f.out, "Output folder");
   c.add_flag("--quiet", f.quiet, "No progress on standard error");

@@ -21,6 +21,7 @@
 // point within 2e-4 of the prediction, relative to the state) and shrinks after hard ones, after
 // a failed correction, a turn of the tangent by more than 30°, or where the problem finds that
 // something it watches moved too far in one step.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -243,7 +244,7 @@ class CurveWalk {
   // Whether the step from `from` to `to` moved something the problem watches further than one
   // step may (a Floquet multiplier near the unit circle, which could have left it and come back
   // unseen): the step is halved, as after a sharp turn of the tangent, down to four times the
-  // smallest step.
+  // smallest step, and the step after the point then accepted does not grow past it.
   virtual bool too_long(const P& /*from*/, const P& /*to*/) { return false; }
   // Accepts `to`, the walk's point number `points`: the events between the two points, the
   // output. A reason returned stops the walk there, `to` not kept as the walk's last point.
@@ -265,6 +266,7 @@ class CurveWalk {
     double h = steps.initial;
     int points = 1;
     int crawling = 0;  // accepted steps in a row at the smallest steps
+    bool held = false;  // the problem cut this step: the next does not grow past it
     Vector previous_secant;
     const auto end = [&](WalkEnd::Kind kind, std::string why) {
       if (last != nullptr) *last = current;
@@ -285,6 +287,7 @@ class CurveWalk {
       }
       if (h > 4 * steps.min && too_long(current, *next)) {
         h /= 2;
+        held = true;
         continue;
       }
       // A step that turns back on the previous one (the secants at more than 90°) has gone back
@@ -316,7 +319,10 @@ class CurveWalk {
       if (steps.stall_steps > 0 && crawling >= steps.stall_steps) {
         return end(WalkEnd::Kind::stalled, "");
       }
-      h = steps.next(h, predictor_error, iterations, parameter_share(current.tangent));
+      const double grown =
+          steps.next(h, predictor_error, iterations, parameter_share(current.tangent));
+      h = held ? std::min(h, grown) : grown;
+      held = false;
     }
   }
 

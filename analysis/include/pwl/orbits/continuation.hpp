@@ -74,11 +74,11 @@
 // corrector is dense only.
 //
 // A band round the circle (ShootingOptions::arnoldi.margin > 0, dense or matrix-free): a step is
-// halved while a multiplier within half the margin of the circle at one end has none within half
-// the margin of it at the other, so that a multiplier does not leave the circle and come back (a
-// window of stability or instability shorter than a step, the same signature at both ends)
-// between two points unseen; see the head of BranchWalk::too_long in continuation.cpp for what
-// this rests on.
+// halved while a multiplier within half the margin of the circle at one end has no partner of its
+// own (one to one) within half the margin of it at the other, so that a multiplier does not leave
+// the circle and come back (a window of stability or instability shorter than a step, the same
+// signature at both ends) between two points unseen; BranchWalk::too_long in continuation.cpp
+// says what this rests on and what it does not catch.
 #include <complex>
 #include <string>
 #include <vector>
@@ -188,8 +188,9 @@ struct ContinuationResult {
   // ArnoldiOptions::margin within half Arnoldi's basis (more may lie in it, outside the circle
   // with margin 0, than were reported).
   long uncovered_bands = 0;
-  // Steps halved because a multiplier near the unit circle moved more than half the band's
-  // margin (ArnoldiOptions::margin > 0 only; see the head of this file).
+  // Steps halved because a multiplier within half the band's margin of the unit circle at one end
+  // had no partner of its own within half the margin at the other (ArnoldiOptions::margin > 0
+  // only; see the head of this file).
   long band_cuts = 0;
   // Steps cut in two because the multipliers' signature changed in a way the events located in
   // them did not explain (several events in one step).
