@@ -16,6 +16,7 @@
 #include <cmath>
 #include <complex>
 #include <functional>
+#include <utility>
 #include <vector>
 
 namespace pwl::orbits::detail {
