@@ -12,6 +12,14 @@
 //  - strong resonances on Neimark–Sacker curves: a 1:4 point where a continuation in θ at its α
 //    locates the Neimark–Sacker point at the same θ with its multiplier at ±i, and a 1:2 point
 //    whose orbit has two multipliers at −1, neither also reported as a flip– or fold–NS point.
+// Grazing curves matrix-free (Newton–Krylov on the doubly bordered system, the gap's gradient known
+// only by its products, the multipliers by Arnoldi; the solver forced to krylov on the 5-DOF chain,
+// where dense truth is at hand): the closed-form curves above; a grazing curve through motion with
+// contact (figure 5's chain in (θ, α)) whose points one-parameter continuations in θ locate to
+// 1e-8, whose Neimark–Sacker–grazing point has a pair of the dense monodromy on the circle and lies
+// where the dense curve puts it, and whose period-doubling–grazing point has a multiplier at −1;
+// beyond the dense limit grazing curves followed and the others noted, and a run with none to
+// follow refused naming the limit.
 #include <catch2/catch.hpp>
 #include <Eigen/LU>
 #include <cmath>
@@ -19,6 +27,7 @@
 #include <functional>
 
 #include "orbit_cases.hpp"
+#include "pwl/errors.hpp"
 #include "pwl/model/chain_builders.hpp"
 #include "pwl/orbits/bifurcation_curves.hpp"
 #include "pwl/orbits/periodic_orbit.hpp"
@@ -93,10 +102,45 @@ std::vector<const CurvePointRecord*> rows_of(const CurvesResult& r, int curve) {
   return rows;
 }
 
+// The bifurcations of `type` located on branch 0 of a continuation.
+std::vector<Bifurcation> located_in(const ContinuationResult& r, BifurcationType type) {
+  std::vector<Bifurcation> found;
+  for (const Bifurcation& b : r.bifurcations) {
+    if (b.type == type && b.located && b.branch == 0) found.push_back(b);
+  }
+  return found;
+}
+
+// Grazing curves in (θ, α) over [1.4, 1.6] × [4.5, 5.5], dense or matrix-free.
+CurvesOptions mf_grazing_options(bool matrix_free) {
+  CurvesOptions c =
+      curves_options(1.4, 1.6, SweepParameter::alpha, 4.5, 5.5, {CurveType::grazing});
+  if (matrix_free) c.shooting.solver = ShootingSolver::krylov;
+  return c;
+}
+
+const Codim2Point* codim2_of(const CurvesResult& r, const std::string& type) {
+  for (const Codim2Point& c : r.codim2) {
+    if (c.type == type) return &c;
+  }
+  return nullptr;
+}
+
+// The multipliers of the dense monodromy of the orbit through `state` of `chain` at (θ, α).
+FloquetMultipliers multipliers_at(NondimensionalChain chain, double theta, double alpha,
+                                  const Vector& state) {
+  chain.theta = theta;
+  chain.alpha = {alpha};
+  StroboscopicMap map(analysis::PointCase(chain), MethodSettings{Method::exact}, 1);
+  Matrix M;
+  map.advance_with_jacobian(state, 1, M);
+  return floquet_multipliers(M);
+}
+
 }  // namespace
 
 TEST_CASE("grazing curves of a contact-free branch follow the closed form, and meet in a double "
-          "grazing where two amplitudes are equal",
+          "grazing where two amplitudes are equal, dense and matrix-free",
           "[orbits][curves]") {
   // Figure 4a's chain with gaps of 1: from θ = 0.8 down, spring 2 lets go at θ = 0.6817 and the
   // orbit is linear until spring 4 touches at θ = 0.6170.
@@ -110,10 +154,20 @@ TEST_CASE("grazing curves of a contact-free branch follow the closed form, and m
   REQUIRE(grazings.size() == 2);
   CHECK(grazings[0].spring == 1);
   CHECK(grazings[1].spring == 3);
-  const CurvesOptions o =
+  // The same curves by the dense defining system and matrix-free (Newton–Krylov, the gap's gradient
+  // known by its products, the multipliers by Arnoldi).
+  const bool matrix_free = GENERATE(false, true);
+  const std::string solver = matrix_free ? "matrix-free" : "dense";
+  INFO(solver);
+  CurvesOptions o =
       curves_options(0.8, 0.6, SweepParameter::gap, 0.9, 1.1, {CurveType::grazing});
+  if (matrix_free) o.shooting.solver = ShootingSolver::krylov;
   const CurvesResult r = follow_bifurcation_curves(analysis::PointModel(chain), grazings, o);
   REQUIRE(r.curves.size() == 2);
+  // Matrix-free: no monodromy formed, the products counted.
+  CHECK((r.monodromies == 0) == matrix_free);
+  CHECK((r.krylov_products > 0) == matrix_free);
+  CHECK((r.arnoldi_products > 0) == matrix_free);
   // Every point of the curves where the closed form says the orbit is contact-free lies on
   // Δ̃ = |(H Q)_s|.
   double worst = 0.0;
@@ -128,7 +182,7 @@ TEST_CASE("grazing curves of a contact-free branch follow the closed form, and m
     worst = std::max(worst, std::abs(a(p.spring) - p.q));
     ++checked;
   }
-  measured("grazing curves: |gap - |HQ|_s| over contact-free points", worst);
+  measured(solver + " grazing curves: |gap - |HQ|_s| over contact-free points", worst);
   CHECK(checked >= 40);
   CHECK(worst <= 1e-9);
 
@@ -151,8 +205,8 @@ TEST_CASE("grazing curves of a contact-free branch follow the closed form, and m
   }
   REQUIRE(dg != nullptr);
   INFO("double grazing at theta = " << dg->p << ", gap = " << dg->q);
-  measured("double grazing: theta - closed form", dg->p - theta_star);
-  measured("double grazing: gap - closed form", dg->q - gap_star);
+  measured(solver + " double grazing: theta - closed form", dg->p - theta_star);
+  measured(solver + " double grazing: gap - closed form", dg->q - gap_star);
   CHECK(std::abs(dg->p - theta_star) <= 1e-8);
   CHECK(std::abs(dg->q - gap_star) <= 1e-8);
   // Found on both curves: and each curve alone lands on the same point.
@@ -165,7 +219,8 @@ TEST_CASE("grazing curves of a contact-free branch follow the closed form, and m
     }
   }
   REQUIRE(alone.size() == 2);
-  measured("double grazing from the two curves: |dtheta|", std::abs(alone[0].p - alone[1].p));
+  measured(solver + " double grazing from the two curves: |dtheta|",
+           std::abs(alone[0].p - alone[1].p));
   CHECK(std::abs(alone[0].p - alone[1].p) <= 1e-8);
   CHECK(std::abs(alone[0].q - alone[1].q) <= 1e-8);
 }
@@ -349,4 +404,126 @@ TEST_CASE("strong resonances on a Neimark-Sacker curve sit where a one-parameter
       CHECK(near == 2);
     }
   }
+}
+
+TEST_CASE("a matrix-free grazing curve through motion with contact agrees with one-parameter "
+          "continuations, and its codimension-two points with the dense monodromy",
+          "[orbits][curves]") {
+  // Figure 5's chain (α = 5): from θ = 1.45 up spring 3 grazes at θ = 1.4837, between two period
+  // doublings. Its curve in (θ, α) meets a Neimark–Sacker curve near α = 4.74 and a
+  // period-doubling curve near α = 5.41.
+  const NondimensionalChain chain = paper_five_dof_case("5");
+  NondimensionalChain start = chain;
+  start.theta = 1.45;
+  const std::vector<Bifurcation> grazings =
+      located_in(branch(chain, 1.45, 1.5), BifurcationType::grazing);
+  REQUIRE(grazings.size() == 1);
+  REQUIRE(grazings[0].spring == 2);
+  const analysis::PointModel model(start);
+  const CurvesResult r = follow_bifurcation_curves(
+      model, grazings, mf_grazing_options(true));
+  const CurvesResult dense = follow_bifurcation_curves(
+      model, grazings, mf_grazing_options(false));
+  REQUIRE(r.curves.size() == 1);
+  CHECK(r.monodromies == 0);
+  CHECK(dense.krylov_products == 0);
+  // The curve crosses the whole α range: both ends on its edges.
+  for (const std::string& end : r.curves[0].ends) CHECK(end.find("left the alpha range") == 0);
+
+  // Five points: the one-parameter continuation in θ at their α locates spring 3's grazing there.
+  std::vector<const CurvePointRecord*> rows;
+  for (const CurvePointRecord& p : r.points) rows.push_back(&p);
+  REQUIRE(rows.size() >= 12);
+  int compared = 0;
+  for (std::size_t i = 1; i < rows.size() && compared < 5; i += rows.size() / 6) {
+    const CurvePointRecord& p = *rows[i];
+    NondimensionalChain at = chain;
+    at.alpha = {p.q};
+    double nearest = 1e300;
+    for (const Bifurcation& b :
+         located_in(branch(at, p.p - 0.004, p.p + 0.004), BifurcationType::grazing)) {
+      if (b.spring == 2 && b.at_largest_gap == p.at_largest_gap &&
+          std::abs(b.parameter - p.p) < std::abs(nearest - p.p)) {
+        nearest = b.parameter;
+      }
+    }
+    INFO("alpha = " << p.q << ": curve theta " << p.p << ", one-parameter " << nearest);
+    measured("matrix-free grazing curve theta - one-parameter continuation", p.p - nearest);
+    CHECK(std::abs(p.p - nearest) <= 1e-8);
+    ++compared;
+  }
+  CHECK(compared == 5);
+
+  // The Neimark–Sacker–grazing point: a pair of the dense monodromy's multipliers on the circle,
+  // and where the dense curve finds it.
+  const Codim2Point* ns = codim2_of(r, "neimark-sacker-grazing");
+  const Codim2Point* ns_dense = codim2_of(dense, "neimark-sacker-grazing");
+  REQUIRE(ns != nullptr);
+  REQUIRE(ns_dense != nullptr);
+  const FloquetMultipliers at_ns = multipliers_at(chain, ns->p, ns->q, ns->state);
+  double pair = 1e300;
+  for (const auto& m : at_ns.values) {
+    if (std::abs(m.imag()) > 1e-6) pair = std::min(pair, std::abs(std::abs(m) - 1.0));
+  }
+  measured("matrix-free NS-grazing: |mu| - 1 of the dense monodromy's pair", pair);
+  measured("matrix-free NS-grazing: alpha - dense curves'", ns->q - ns_dense->q);
+  CHECK(pair <= 1e-8);
+  CHECK(std::abs(ns->p - ns_dense->p) <= 1e-8);
+  CHECK(std::abs(ns->q - ns_dense->q) <= 1e-8);
+
+  // The period-doubling–grazing point: a multiplier at −1. Along a grazing curve the orbit's
+  // extreme gap is zero only to rounding, and on the contact side the spring acts for a time like
+  // the square root of that: the multipliers, a smooth function of α on the free side, carry a
+  // noise like √(1e-16) times the contact's weight. Measured at the dense curve's point: |μ + 1| =
+  // 2.7e-8 as it is, 3.8e-7 with the gaps 1e-14 wider (free), 2.5e-6 with them 1e-14 narrower. The
+  // multiplier moves only 0.03 per unit of α there, so either curve places the point to ~1e-7 in α
+  // (measured: 1.8e-7 apart, the matrix-free one 1.1e-14 from −1); the bounds below allow ten
+  // times the measured noise.
+  const Codim2Point* pd = codim2_of(r, "period-doubling-grazing");
+  const Codim2Point* pd_dense = codim2_of(dense, "period-doubling-grazing");
+  REQUIRE(pd != nullptr);
+  REQUIRE(pd_dense != nullptr);
+  const FloquetMultipliers at_pd = multipliers_at(chain, pd->p, pd->q, pd->state);
+  double flip = 1e300;
+  for (const auto& m : at_pd.values) flip = std::min(flip, std::abs(m + 1.0));
+  measured("matrix-free PD-grazing: |mu + 1| of the dense monodromy", flip);
+  measured("matrix-free PD-grazing: alpha - dense curves'", pd->q - pd_dense->q);
+  CHECK(flip <= 1e-6);
+  CHECK(std::abs(pd->q - pd_dense->q) <= 2e-6);
+  CHECK(std::abs(pd->p - pd_dense->p) <= 1e-7);
+}
+
+TEST_CASE("beyond the dense limit grazing curves are followed matrix-free, the others noted, "
+          "and a run with none to follow refused",
+          "[orbits][curves]") {
+  const NondimensionalChain chain = paper_five_dof_case("5");
+  NondimensionalChain start = chain;
+  start.theta = 1.45;
+  const ContinuationResult b = branch(chain, 1.45, 1.5);
+  std::vector<Bifurcation> starts;
+  for (const Bifurcation& x : b.bifurcations) {
+    if (x.located && x.branch == 0) starts.push_back(x);
+  }
+  const std::vector<Bifurcation> doublings =
+      located_in(b, BifurcationType::period_doubling);
+  REQUIRE(doublings.size() == 2);
+  CurvesOptions o = mf_grazing_options(false);
+  o.types = {CurveType::period_doubling, CurveType::grazing};
+  o.shooting.dense_state_limit = 8;  // below the chain's 10 state components
+  o.max_points = 5;
+  const CurvesResult r = follow_bifurcation_curves(analysis::PointModel(start), starts, o);
+  REQUIRE(r.curves.size() == 1);
+  CHECK(r.curves[0].type == CurveType::grazing);
+  CHECK(r.monodromies == 0);
+  CHECK(r.krylov_products > 0);
+  int noted = 0;
+  for (const std::string& n : r.notes) {
+    noted += n.find("not followed") != std::string::npos &&
+             n.find("dense limit of 8 state components") != std::string::npos;
+  }
+  CHECK(noted == 2);
+  o.types = {CurveType::period_doubling};
+  CHECK_THROWS_AS(follow_bifurcation_curves(analysis::PointModel(start), doublings, o), InputError);
+  CHECK_THROWS_WITH(follow_bifurcation_curves(analysis::PointModel(start), doublings, o),
+                    Catch::Contains("dense limit is 8 state components"));
 }

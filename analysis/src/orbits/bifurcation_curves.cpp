@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "curve_systems.hpp"
+#include "matrix_free_grazing.hpp"
 #include "pwl/errors.hpp"
 
 namespace pwl::orbits {
@@ -78,6 +79,7 @@ namespace {
 using curves_detail::CurveSystem;
 using curves_detail::GrazingSystem;
 using curves_detail::NeimarkSackerSystem;
+using curves_detail::MatrixFreeGrazing;
 using curves_detail::PlaneMaps;
 using curves_detail::SingularSystem;
 
@@ -99,21 +101,21 @@ constexpr int kStallSteps = 20;
 // A point of a curve: the unknowns, and what was computed there.
 struct CurvePt : CurvePoint {
   Matrix jacobian;  // ∂G/∂u (the chord corrector's start, the tangent)
-  Matrix M;         // monodromy
+  Matrix M;         // monodromy (dense only)
   FloquetMultipliers mu;
+  Eigen::MatrixXcd ritz;  // matrix-free: the Ritz vectors of mu (the next point's warm start)
   std::optional<OrbitProfile> profile;
   std::vector<double> tests;  // the curve's codimension-two test functions (NaN: not computed)
 };
 
-// Re Π (μ_i − target), leaving out the multiplier nearest `target` when `skip_nearest`.
-double shifted_product(const FloquetMultipliers& mu, double target, bool skip_nearest) {
+// Re Π (μ_i − target) over every multiplier but the one nearest `target` (dense curves: all of
+// them): zero where a second multiplier reaches target.
+double second_product(const FloquetMultipliers& mu, double target) {
   std::size_t nearest = mu.values.size();
-  if (skip_nearest) {
-    for (std::size_t i = 0; i < mu.values.size(); ++i) {
-      if (nearest == mu.values.size() ||
-          std::abs(mu.values[i] - target) < std::abs(mu.values[nearest] - target)) {
-        nearest = i;
-      }
+  for (std::size_t i = 0; i < mu.values.size(); ++i) {
+    if (nearest == mu.values.size() ||
+        std::abs(mu.values[i] - target) < std::abs(mu.values[nearest] - target)) {
+      nearest = i;
     }
   }
   std::complex<double> product = 1.0;
@@ -149,8 +151,8 @@ int complex_outside(const FloquetMultipliers& mu) {
 // One codimension-two test of a curve.
 struct Test {
   enum class Kind {
-    det_minus,       // Re Π(μ − 1)
-    det_plus,        // Re Π(μ + 1)
+    det_minus,       // det(I − M), over the leading multipliers where matrix-free
+    det_plus,        // det(I + M), likewise
     second_plus,     // Re Π(μ − 1) without the multiplier nearest +1
     second_minus,    // Re Π(μ + 1) without the multiplier nearest −1
     kappa,           // κ − value
@@ -232,6 +234,14 @@ class CurvesRunner {
     summary.spring = b.spring;
     summary.at_largest_gap = b.at_largest_gap;
     const Index n = b.state.size();
+    if (summary.type != CurveType::grazing && n > options_.shooting.dense_state_limit) {
+      note(fmt::format("curve {} ({} at {} = {:.10g}): not followed: its defining system forms the "
+                       "{}x{} monodromy, beyond the dense limit of {} state components (only "
+                       "grazing curves are matrix-free)",
+                       id, curve_type_name(summary.type), options_.first.name(), b.parameter, n,
+                       n, options_.shooting.dense_state_limit));
+      return;
+    }
     chord_ = options_.corrector == Corrector::chord ||
              (options_.corrector == Corrector::automatic && n > kChordAbove);
     std::unique_ptr<CurveSystem> system;
@@ -251,6 +261,8 @@ class CurvesRunner {
       return;
     }
     system_ = system.get();
+    free_ = dynamic_cast<MatrixFreeGrazing*>(system_);
+    warm_.resize(0, 0);
     type_ = summary.type;
     curve_ = id;
     spring_ = b.spring;
@@ -273,12 +285,13 @@ class CurvesRunner {
       return;
     }
     system_->refresh();
-    first->tangent = curve_tangent(first->jacobian, hold);
+    first->tangent = tangent_at(*first, hold);
     if (!first->tangent.allFinite()) {
       Vector along_p = Vector::Zero(guess.size());
       along_p(n) = 1.0;
-      first->tangent = curve_tangent(first->jacobian, along_p);
+      first->tangent = tangent_at(*first, along_p);
     }
+    warm_ = first->ritz;
     summary.start_p = system_->p(first->u);
     summary.start_q = system_->q(first->u);
     emit(*first);
@@ -358,6 +371,10 @@ class CurvesRunner {
     const Index n = b.state.size();
     const int k = b.period;
     if (b.type == BifurcationType::grazing) {
+      if (matrix_free(n)) {
+        return std::make_unique<MatrixFreeGrazing>(maps_, k, n, p_scale_, q_scale_, b.spring,
+                                                   b.at_largest_gap, b.parameter, q0_);
+      }
       return std::make_unique<GrazingSystem>(maps_, k, n, p_scale_, q_scale_, b.spring,
                                              b.at_largest_gap);
     }
@@ -449,11 +466,40 @@ class CurvesRunner {
     return *pt.profile;
   }
 
+  // Whether a grazing curve of n state components is followed matrix-free: where the solver is
+  // krylov, or automatic beyond the dense limit.
+  bool matrix_free(Index n) const {
+    const ShootingOptions& s = options_.shooting;
+    return s.solver == ShootingSolver::krylov ||
+           (s.solver == ShootingSolver::automatic && n > s.dense_state_limit);
+  }
+
+  // The unit tangent at a corrected point, oriented like `previous`.
+  Vector tangent_at(const CurvePt& pt, const Vector& previous) {
+    if (free_ != nullptr) return free_->tangent(pt.u, previous);
+    return curve_tangent(pt.jacobian, previous);
+  }
+
   // The curve's point corrected from `guess` with τ · (u − prediction) = 0, completed with its
-  // multipliers and its tests.
+  // multipliers and its tests. Matrix-free: by Newton–Krylov (twice as many steps as the dense
+  // corrector forms Jacobians, as the one-parameter continuation allows), and the leading
+  // multipliers by Arnoldi warm-started from the last accepted point.
   std::optional<CurvePt> corrected(const Vector& guess, const Vector& prediction,
                                    const Vector& tau, const Matrix* start, int corrections,
                                    double polish) {
+    if (free_ != nullptr) {
+      std::optional<MatrixFreeGrazing::Corrected> c =
+          free_->correct(guess, prediction, tau, 2 * corrections, polish);
+      if (!c) return std::nullopt;
+      CurvePt pt;
+      pt.u = std::move(c->u);
+      pt.residual = c->residual;
+      pt.iterations = c->iterations;
+      pt.mu = free_->multipliers(pt.u, warm_.size() > 0 ? &warm_ : nullptr, &pt.ritz);
+      if (!pt.mu.converged) ++result_.unconverged_multipliers;
+      pt.tests = evaluate_tests(pt);
+      return pt;
+    }
     std::optional<CorrectedPoint> c = correct_on_curve(
         *system_, guess, prediction, tau, start, corrector_settings(corrections, polish, true));
     if (!c) return std::nullopt;
@@ -475,10 +521,10 @@ class CurvesRunner {
       using K = Test::Kind;
       double v = kNaN;
       switch (t.kind) {
-        case K::det_minus: v = shifted_product(pt.mu, 1.0, false); break;
-        case K::det_plus: v = shifted_product(pt.mu, -1.0, false); break;
-        case K::second_plus: v = shifted_product(pt.mu, 1.0, true); break;
-        case K::second_minus: v = shifted_product(pt.mu, -1.0, true); break;
+        case K::det_minus: v = pt.mu.shifted_determinant(1.0); break;
+        case K::det_plus: v = pt.mu.shifted_determinant(-1.0); break;
+        case K::second_plus: v = second_product(pt.mu, 1.0); break;
+        case K::second_minus: v = second_product(pt.mu, -1.0); break;
         case K::kappa: v = pt.u(pt.u.size() - 1) - t.value; break;
         case K::complex_pairs: v = nearest_pair_distance(pt.mu); break;
         case K::gap: {
@@ -558,7 +604,7 @@ class CurvesRunner {
       std::optional<CurvePt> next = r_.corrected(predicted, predicted, from.tangent, &from.jacobian,
                                                  r_.options_.max_corrections, 0.0);
       if (!next) return std::nullopt;
-      next->tangent = curve_tangent(next->jacobian, from.tangent);
+      next->tangent = r_.tangent_at(*next, from.tangent);
       if (!next->tangent.allFinite()) return std::nullopt;
       return next;
     }
@@ -628,6 +674,7 @@ class CurvesRunner {
     std::optional<std::string> accept(CurvePt& from, CurvePt& to, double h,
                                       int /*points*/) override {
       r_.system_->refresh();
+      r_.warm_ = to.ritz;
       r_.cross(from, to, h);
       r_.detect(from, to, h);
       r_.emit(to);
@@ -686,12 +733,19 @@ class CurvesRunner {
                            double sb) -> std::optional<std::pair<CurvePt, double>> {
       const double w = (s - sa) / (sb - sa);
       const Vector guess = (1 - w) * end_a.u + w * end_b.u;
-      std::optional<CorrectedPoint> c =
-          correct_on_curve(*system_, guess, a.u + s * a.tangent, a.tangent, &a.jacobian,
-                           corrector_settings(options_.max_corrections + 3, 0.0, false));
-      if (!c) return std::nullopt;
       CurvePt pt;
-      pt.u = std::move(c->u);
+      if (free_ != nullptr) {
+        std::optional<MatrixFreeGrazing::Corrected> c = free_->correct(
+            guess, a.u + s * a.tangent, a.tangent, 2 * (options_.max_corrections + 3), 0.0);
+        if (!c) return std::nullopt;
+        pt.u = std::move(c->u);
+      } else {
+        std::optional<CorrectedPoint> c =
+            correct_on_curve(*system_, guess, a.u + s * a.tangent, a.tangent, &a.jacobian,
+                             corrector_settings(options_.max_corrections + 3, 0.0, false));
+        if (!c) return std::nullopt;
+        pt.u = std::move(c->u);
+      }
       const double f = system_->q(pt.u) - q0_;
       return std::pair<CurvePt, double>{std::move(pt), f};
     };
@@ -848,6 +902,8 @@ class CurvesRunner {
   bool chord_ = false;
   // The curve being followed.
   CurveSystem* system_ = nullptr;
+  MatrixFreeGrazing* free_ = nullptr;  // the same system where it is matrix-free
+  Eigen::MatrixXcd warm_;              // matrix-free: the last accepted point's Ritz vectors
   CurveType type_ = CurveType::fold;
   int curve_ = 0;
   int spring_ = -1;
@@ -883,13 +939,29 @@ CurvesResult follow_bifurcation_curves(const analysis::PointModel& model,
                                    options.q_from, options.q_to, options.second.name(), q, why));
     }
   }
+  // Beyond the dense limit only grazing curves can be followed (matrix-free); a run that could
+  // follow none of its starts is refused, one that can follow some notes the others.
+  bool any = true;
   for (const Bifurcation& start : starts) {
-    if (start.state.size() > options.shooting.dense_state_limit) {
-      throw InputError(fmt::format(
-          "bifurcation curves form the {0}x{0} monodromy of their defining systems, which are "
-          "not matrix-free; the dense limit is {1} state components",
-          start.state.size(), options.shooting.dense_state_limit));
+    const CurveType type = curve_type_of(start.type);
+    if (std::find(options.types.begin(), options.types.end(), type) != options.types.end()) {
+      any = false;
     }
+  }
+  for (const Bifurcation& start : starts) {
+    const CurveType type = curve_type_of(start.type);
+    if (std::find(options.types.begin(), options.types.end(), type) == options.types.end()) {
+      continue;
+    }
+    any = any || type == CurveType::grazing ||
+          start.state.size() <= options.shooting.dense_state_limit;
+  }
+  if (!any) {
+    throw InputError(fmt::format(
+        "the curves of folds, period doublings and Neimark-Sacker points form the {0}x{0} "
+        "monodromy of their defining systems, which are not matrix-free; the dense limit is {1} "
+        "state components (grazing curves are followed matrix-free)",
+        starts.front().state.size(), options.shooting.dense_state_limit));
   }
   CurvesResult result;
   CurvesRunner runner(model, options, observer, result);

@@ -1,31 +1,45 @@
 #pragma once
-// The bordered linear system of matrix-free continuation, solved by GMRES on products of the
+// The bordered linear systems of matrix-free continuation, solved by GMRES on products of the
 // monodromy. Private to the orbits room.
 //
-//     [ M − I   b ] [ x ]   [ r ]
-//     [  cᵀ     d ] [ s ] = [ ρ ]
+//     [ M − I   B ] [ x ]   [ r ]
+//     [  Cᵀ     D ] [ s ] = [ ρ ]
 //
 // with M the monodromy (known only by its products M v, each a tangent integration of the map,
-// replayed from one recorded integration where the integrator records its tangent), b = ∂F/∂p,
-// and the border row (cᵀ, d) the continuation's: the tangent of the branch for the corrector's
-// arclength condition, or the previous tangent for the new one. The border makes the matrix
-// regular at a fold, where M − I alone is singular (H. B. Keller, in Applications of Bifurcation
-// Theory, Academic Press 1977, 359-384; the matrix-free form for periodic orbits: K. Lust,
-// D. Roose, A. Spence and A. R. Champneys, SIAM J. Sci. Comput. 19 (1998) 1188-1209).
+// replayed from one recorded integration where the integrator records its tangent) and k borders:
+// B (n × k), C (n × k), D (k × k). In one parameter k = 1: b = ∂F/∂p and the border row (cᵀ, d)
+// the continuation's, the tangent of the branch for the corrector's arclength condition or the
+// previous tangent for the new one. On a bifurcation curve in two parameters k = 2: B = [∂F/∂p,
+// ∂F/∂q] and the rows are the curve's condition and the arclength condition. The border makes the
+// matrix regular at a fold of the curve, where M − I alone is singular (H. B. Keller, in
+// Applications of Bifurcation Theory, Academic Press 1977, 359-384; the matrix-free form for
+// periodic orbits: K. Lust, D. Roose, A. Spence and A. R. Champneys, SIAM J. Sci. Comput. 19
+// (1998) 1188-1209).
+//
+// Rows known only by their products. A border row may be known only by its products cᵀ v with
+// tangent vectors, not as a vector: the gradient of a gap function's extreme along the orbit is
+// the gap's row of the state transition matrix at the extreme's time, which a forward tangent
+// integration gives as products and only n of them as a vector. The first `implicit_rows` rows
+// are such: `product(v)` returns M v followed by their products, and C's first columns hold what
+// the preconditioner takes for them (zeros where nothing better is known). The operator GMRES sees
+// is exact; only the preconditioner differs from it, by one rank per such row, which costs GMRES
+// about one product more each.
 //
 // Preconditioning. GMRES is right-preconditioned by the inverse of the same bordered matrix with
 // M replaced by the open structure's monodromy M0 (open_structure_preconditioner.hpp: modal 2 x 2
-// blocks), applied by block elimination: with A0 = M0 − I, z_b = A0⁻¹ b, 
+// blocks), applied by block elimination: with A0 = M0 − I, Z_B = A0⁻¹ B and the k × k Schur
+// complement S = D − Cᵀ Z_B,
 //
-//     s = (ρ − cᵀ A0⁻¹ r) / (d − cᵀ z_b),   x = A0⁻¹ r − s z_b,
+//     s = S⁻¹ (ρ − Cᵀ A0⁻¹ r),   x = A0⁻¹ r − Z_B s,
 //
-// one A0⁻¹ product per application (z_b once per system). Where M = M0 (the springs never act
-// during the orbit) this is the exact inverse and GMRES converges in one product; otherwise the
-// preconditioned operator is the identity plus what the contacts change, which is what the slow
-// long-wave modes of a chain (many multipliers near 1) no longer dominate. Where the eliminated
-// pivot d − cᵀ z_b vanishes (the border orthogonal to A0⁻¹'s image of b) the border is left
-// unpreconditioned: diag(A0⁻¹, 1). Without the open structure's inverse (non-classical damping)
-// GMRES runs unpreconditioned.
+// one A0⁻¹ product per application (Z_B once per system). Where M = M0 (the springs never act
+// during the orbit) and every row is known this is the exact inverse and GMRES converges in one
+// product; otherwise the preconditioned operator is the identity plus what the contacts change,
+// which is what the slow long-wave modes of a chain (many multipliers near 1) no longer dominate.
+// Where S is nearly singular (its smallest singular value below 1e-10 of the borders' size) the
+// borders are left unpreconditioned: diag(A0⁻¹, I). Without the open structure's inverse
+// (non-classical damping) GMRES runs unpreconditioned.
+#include <Eigen/SVD>
 #include <cmath>
 #include <functional>
 #include <utility>
@@ -38,61 +52,95 @@ namespace pwl::orbits::detail {
 
 class BorderedKrylov {
  public:
-  // `product(v)` returns M v. `open` may be null or unavailable (no preconditioning).
+  // `product(v)` returns M v, followed by the products of the first `implicit_rows` border rows
+  // with v. `open` may be null or unavailable (no preconditioning).
   BorderedKrylov(std::function<Vector(const Vector&)> product,
-                 const OpenStructurePreconditioner* open, Vector b, Vector c, double d)
-      : product_(std::move(product)), b_(std::move(b)), c_(std::move(c)), d_(d) {
+                 const OpenStructurePreconditioner* open, Matrix B, Matrix C, Matrix D,
+                 Index implicit_rows = 0)
+      : product_(std::move(product)),
+        B_(std::move(B)),
+        C_(std::move(C)),
+        D_(std::move(D)),
+        implicit_(implicit_rows) {
+    // The operator's rows: the products stand in for C's first columns.
+    C_known_ = C_;
+    C_known_.leftCols(implicit_).setZero();
     if (open != nullptr && open->available()) {
       open_ = open;
-      z_b_ = open_->apply(b_);
-      pivot_ = d_ - c_.dot(z_b_);
-      const double size = std::abs(d_) + c_.norm() * z_b_.norm();
-      eliminate_ = std::isfinite(pivot_) && std::abs(pivot_) > 1e-10 * size;
+      Z_B_.resize(B_.rows(), B_.cols());
+      for (Index j = 0; j < B_.cols(); ++j) Z_B_.col(j) = open_->apply(B_.col(j));
+      const Matrix S = D_ - C_.transpose() * Z_B_;
+      const double size = D_.norm() + C_.norm() * Z_B_.norm();
+      if (S.allFinite()) {
+        const Eigen::JacobiSVD<Matrix> svd(S);
+        if (svd.singularValues().minCoeff() > 1e-10 * size) {
+          S_inverse_ = S.inverse();
+          eliminate_ = S_inverse_.allFinite();
+        }
+      }
     }
   }
+  // One border: [M − I, b; cᵀ, d].
+  BorderedKrylov(std::function<Vector(const Vector&)> product,
+                 const OpenStructurePreconditioner* open, const Vector& b, const Vector& c,
+                 double d)
+      : BorderedKrylov(std::move(product), open, Matrix(b), Matrix(c), Matrix::Constant(1, 1, d)) {}
 
   // Solves to |residual| <= tolerance |[r; ρ]| (2-norms) from zero, at most `restarts` + 1
   // cycles of `dimension` products. Returns what GMRES reached.
-  GmresResult solve(const Vector& r, double rho, Vector& x, double& s, double tolerance,
+  GmresResult solve(const Vector& r, const Vector& rho, Vector& x, Vector& s, double tolerance,
                     int dimension, int restarts) const {
-    const Index n = r.size();
-    Vector rhs(n + 1);
+    const Index n = r.size(), k = borders();
+    Vector rhs(n + k);
     rhs << r, rho;
     const auto apply = [&](const Vector& v) -> Vector {
       const Vector w = precondition(v);
-      Vector out(n + 1);
-      out.head(n) = product_(w.head(n)) - w.head(n) + b_ * w(n);
-      out(n) = c_.dot(w.head(n)) + d_ * w(n);
+      const Vector m = product_(w.head(n));
+      Vector out(n + k);
+      out.head(n) = m.head(n) - w.head(n) + B_ * w.tail(k);
+      out.tail(k) = C_known_.transpose() * w.head(n) + D_ * w.tail(k);
+      if (implicit_ > 0) out.segment(n, implicit_) += m.segment(n, implicit_);
       return out;
     };
     Vector u;
     const GmresResult g = gmres(apply, rhs, u, tolerance, dimension, restarts);
     const Vector z = precondition(u);
     x = z.head(n);
-    s = z(n);
+    s = z.tail(k);
     return g;
   }
+  // One border.
+  GmresResult solve(const Vector& r, double rho, Vector& x, double& s, double tolerance,
+                    int dimension, int restarts) const {
+    Vector sv;
+    const GmresResult g =
+        solve(r, Vector::Constant(1, rho), x, sv, tolerance, dimension, restarts);
+    s = sv(0);
+    return g;
+  }
+
+  Index borders() const { return B_.cols(); }
 
  private:
   Vector precondition(const Vector& v) const {
     if (open_ == nullptr) return v;
-    const Index n = v.size() - 1;
-    Vector out(n + 1);
+    const Index k = borders(), n = v.size() - k;
+    Vector out(n + k);
     const Vector a = open_->apply(v.head(n));
     if (eliminate_) {
-      out(n) = (v(n) - c_.dot(a)) / pivot_;
-      out.head(n) = a - out(n) * z_b_;
+      out.tail(k) = S_inverse_ * (v.tail(k) - C_.transpose() * a);
+      out.head(n) = a - Z_B_ * out.tail(k);
     } else {
       out.head(n) = a;
-      out(n) = v(n);
+      out.tail(k) = v.tail(k);
     }
     return out;
   }
 
   std::function<Vector(const Vector&)> product_;
   const OpenStructurePreconditioner* open_ = nullptr;
-  Vector b_, c_, z_b_;
-  double d_ = 0.0, pivot_ = 0.0;
+  Matrix B_, C_, C_known_, D_, Z_B_, S_inverse_;
+  Index implicit_ = 0;
   bool eliminate_ = false;
 };
 

@@ -115,17 +115,6 @@ std::complex<double> nearest_complex_to_circle(const FloquetMultipliers& mu) {
   return best;
 }
 
-// Re Π (1 − μ_i / target), target = ±1: det(I − M) or det(I + M) when the multipliers are all of
-// them. With the leading ones only (Arnoldi) the product leaves out multipliers inside the unit
-// circle, each of whose factors is positive (a real μ inside gives 1 ∓ μ > 0, a complex pair
-// |1 ∓ μ|² > 0), so a multiplier that enters or leaves the leading set between two points does
-// not change the sign: the sign changes where, and only where, a real multiplier crosses ±1.
-double product_shifted(const FloquetMultipliers& mu, double target) {
-  std::complex<double> product{1.0, 0.0};
-  for (const auto& m : mu.values) product *= 1.0 - m / target;
-  return product.real();
-}
-
 // A point of the branch: u = (y, p), and what was computed there.
 struct Point : CurvePoint {
   Matrix M;  // monodromy (empty where the corrector did not form it at the point)
@@ -867,8 +856,8 @@ class Continuer {
       // det(M − I) and det(M + I) = Π (μ_i ± 1): continuous, and of opposite signs on the two
       // sides of an odd number of real crossings of ±1 (which the detection saw), whichever
       // multiplier crosses, and however fast near a grazing.
-      case BifurcationType::fold: return product_shifted(pt.mu, 1.0);
-      case BifurcationType::period_doubling: return product_shifted(pt.mu, -1.0);
+      case BifurcationType::fold: return pt.mu.shifted_determinant(1.0);
+      case BifurcationType::period_doubling: return pt.mu.shifted_determinant(-1.0);
       // The modulus of the complex pair nearest the circle, less 1 (the second variant: Π over
       // the complex pairs of (|μ|² − 1), which changes sign where one pair crosses). Both jump
       // where multipliers collide on the real axis; explain_signature checks the bracket a

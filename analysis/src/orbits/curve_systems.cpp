@@ -23,16 +23,19 @@ PlaneMaps::PlaneMaps(const analysis::PointModel& model, const CurvesOptions& opt
                      CurvesResult& result)
     : model_(model), options_(options), result_(result) {}
 
-StroboscopicMap& PlaneMaps::at(double p, double q) {
+StroboscopicMap& PlaneMaps::cached(std::map<std::pair<double, double>, StroboscopicMap>& cache,
+                                   std::size_t most, double p, double q) {
   const auto key = std::make_pair(p, q);
-  auto it = maps_.find(key);
-  if (it != maps_.end()) return it->second;
-  if (maps_.size() > 16) maps_.clear();
+  auto it = cache.find(key);
+  if (it != cache.end()) return it->second;
+  if (cache.size() > most) cache.clear();
   const analysis::PointModel point = model_.with(options_.first, p).with(options_.second, q);
-  return maps_
+  return cache
       .emplace(key, StroboscopicMap(point.point_case(), options_.method, options_.steps_per_period))
       .first->second;
 }
+
+StroboscopicMap& PlaneMaps::at(double p, double q) { return cached(maps_, 16, p, q); }
 
 bool PlaneMaps::accepts(double p, double q) const {
   std::string why;
@@ -65,12 +68,18 @@ GapExtreme PlaneMaps::gap_extreme(const Vector& y, double p, double q, int perio
   return orbits::gap_extreme(at(p, q), y, period, spring, largest, options_.profile_samples);
 }
 
+StroboscopicMap& PlaneMaps::second_at(double p, double q) { return cached(seconds_, 4, p, q); }
+
+double PlaneMaps::on_grid(double p, double q, double t) {
+  StroboscopicMap& map = at(p, q);
+  if (!method_traits(map.settings().method).fixed_grid) return t;
+  const double h = map.forcing_period() / map.steps_per_period();
+  return std::round(t / h) * h;
+}
+
 Vector PlaneMaps::flow(const Vector& y, double p, double q, double t, Matrix* tangent) {
   StroboscopicMap& map = at(p, q);
-  if (method_traits(map.settings().method).fixed_grid) {
-    const double h = map.forcing_period() / map.steps_per_period();
-    t = std::round(t / h) * h;
-  }
+  t = on_grid(p, q, t);
   if (!(t > 0)) return y;
   if (tangent != nullptr && tangent->cols() == y.size()) {
     ++result_.monodromies;

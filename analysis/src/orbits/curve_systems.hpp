@@ -33,13 +33,23 @@ class PlaneMaps {
   // The state at time t from y at 0 (a fixed-grid method's nearest grid time), and with
   // `tangent` its product with the state transition matrix.
   Vector flow(const Vector& y, double p, double q, double t, Matrix* tangent = nullptr);
+  // t, or a fixed-grid method's nearest grid time to it.
+  double on_grid(double p, double q, double t);
+  // A second map of (p, q): where products alternate between two arcs of one orbit (up to a time
+  // within the period and on from there), each map records and replays its own arc.
+  StroboscopicMap& second_at(double p, double q);
   const CurvesOptions& options() const { return options_; }
+  CurvesResult& result() { return result_; }
 
  private:
   analysis::PointModel model_;
   const CurvesOptions& options_;
   CurvesResult& result_;
-  std::map<std::pair<double, double>, StroboscopicMap> maps_;
+  std::map<std::pair<double, double>, StroboscopicMap> maps_, seconds_;
+  // The map of (p, q) from `cache`, built there when missing (the cache emptied first when it
+  // holds more than `most`).
+  StroboscopicMap& cached(std::map<std::pair<double, double>, StroboscopicMap>& cache,
+                          std::size_t most, double p, double q);
 };
 
 // What every curve's system shares: the layout of u, the orbit's equations and their Jacobian,
@@ -133,7 +143,7 @@ class GrazingSystem : public CurveSystem {
   bool evaluate(const Vector& u, Vector& G, Matrix* jacobian) override;
   std::complex<double> multiplier(const FloquetMultipliers& mu, const Vector& u) const override;
 
- private:
+ protected:
   int spring_;
   bool at_largest_;
 };

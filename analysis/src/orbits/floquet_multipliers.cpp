@@ -46,6 +46,12 @@ double FloquetMultipliers::largest_modulus() const {
 
 bool FloquetMultipliers::stable(double margin) const { return largest_modulus() < 1.0 - margin; }
 
+double FloquetMultipliers::shifted_determinant(double target) const {
+  std::complex<double> product{1.0, 0.0};
+  for (const auto& m : values) product *= 1.0 - m / target;
+  return product.real();
+}
+
 int FloquetMultipliers::unstable_count() const {
   return static_cast<int>(std::count_if(values.begin(), values.end(),
                                         [](const auto& mu) { return std::abs(mu) > 1.0; }));

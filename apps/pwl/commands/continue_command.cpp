@@ -479,6 +479,15 @@ void continue_orbit(const ContinueFlags& f) {
     }
     fmt::print("curves' work: {} monodromies, {} other integrations of the map\n",
                curves.monodromies, curves.integrations);
+    if (curves.krylov_products > 0 || curves.arnoldi_products > 0) {
+      fmt::print("  matrix-free grazing curves: {} GMRES products, {} Arnoldi products\n",
+                 curves.krylov_products, curves.arnoldi_products);
+      if (curves.unconverged_multipliers > 0) {
+        fmt::print("  at {} point(s) Arnoldi stopped short of its tolerance: the codimension-two "
+                   "tests there rest on unconverged Ritz values\n",
+                   curves.unconverged_multipliers);
+      }
+    }
     fmt::print("curves' time: {:.2f} s ({} rows)\n",
                std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count(),
                curve_outputs.rows());
@@ -621,8 +630,7 @@ ContinuationProblem continuation_problem(const ContinueFlags& f) {
   curves.corrector = c.corrector;
   curves.method = c.method;
   curves.steps_per_period = c.steps_per_period;
-  curves.shooting = c.shooting;
-  curves.shooting.solver = orbits::ShootingSolver::dense;
+  curves.shooting = c.shooting;  // automatic: grazing curves matrix-free beyond the dense limit
   curves.profile_samples = c.profile_samples;
   if (!curves.is_valid(&why)) throw InputError("--curves: " + why);
   problem.curves = curves;
@@ -723,7 +731,8 @@ void add_continue_flags(CLI::App& command, ContinueFlags& flags) {
                      "Neimark-Sacker point and grazing it located in the plane of --parameter\n"
                      "and Q over FROM:TO (any parameter --parameter takes), with their\n"
                      "codimension-two points: OUT/curves.csv, OUT/codim2.csv,\n"
-                     "OUT/bifurcation_curves.png");
+                     "OUT/bifurcation_curves.png. Beyond the dense limit (200 masses) only\n"
+                     "grazing curves are followed, matrix-free");
   command.add_option("--curve-types", flags.curve_types,
                      "The curves to follow: fold, period-doubling, neimark-sacker, grazing,\n"
                      "comma separated (default: all four)")

@@ -45,7 +45,17 @@
 //
 // A curve is followed from its start in both directions, each until it leaves the Q range or the
 // P range, closes on itself, reaches its largest number of points, or cannot go on; the reason is
-// kept. Dense: the monodromy is formed (ShootingOptions::dense_state_limit).
+// kept.
+//
+// Dense or matrix-free. Fold, period-doubling and Neimark–Sacker curves form the monodromy (up to
+// ShootingOptions::dense_state_limit state components; beyond it they are noted and not
+// followed). A grazing curve is followed matrix-free beyond the dense limit, or wherever
+// ShootingOptions::solver is krylov: Newton–Krylov on its doubly bordered system, the gap's
+// gradient known only by its products (matrix_free_grazing.hpp), and the leading multipliers by
+// Arnoldi for the codimension-two tests: det(I ∓ M) over the leading multipliers for the
+// fold–grazing and period-doubling–grazing points, which changes sign where the full determinant
+// does (FloquetMultipliers::shifted_determinant), and the same double-grazing and
+// Neimark–Sacker–grazing tests as dense.
 #include <complex>
 #include <string>
 #include <vector>
@@ -73,6 +83,7 @@ struct CurvesOptions {
   // (first), 1e-7 (smallest) and 1/25 (largest).
   double initial_step = 0.0, min_step = 0.0, max_step = 0.0;
   int max_points = 1000;  // per direction of each curve
+  // Dense curves only: a matrix-free grazing curve corrects by Newton–Krylov.
   Corrector corrector = Corrector::automatic;
   int max_corrections = 7;
   double locate_tolerance = 1e-10;  // of both parameters, for codimension-two points
@@ -127,6 +138,12 @@ struct CurvesResult {
   std::vector<std::string> notes;
   long monodromies = 0;   // integrations with every tangent column
   long integrations = 0;  // others (with one or a few tangent columns, or none)
+  // Matrix-free curves: products with the bordered system in GMRES (each one tangent product over
+  // the period, mostly replayed), products in Arnoldi, and points whose Arnoldi stopped short of
+  // its tolerance.
+  long krylov_products = 0;
+  long arnoldi_products = 0;
+  int unconverged_multipliers = 0;
 };
 
 // Hooks for writing as the curves grow (every hook optional).

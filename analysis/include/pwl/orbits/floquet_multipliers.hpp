@@ -53,6 +53,13 @@ struct FloquetMultipliers {
   bool stable(double margin = 0.0) const;
   // Multipliers outside the unit circle.
   int unstable_count() const;
+  // Re Π (1 − μ_i / target) over the reported multipliers, target = ±1: det(I − M) or det(I + M)
+  // when they are all of them, the test function of a fold or a period doubling. With the leading
+  // ones only (Arnoldi) the product leaves out multipliers inside the unit circle, each of whose
+  // factors is positive (a real μ inside gives 1 ∓ μ > 0, a complex pair |1 ∓ μ|² > 0), so a
+  // multiplier that enters or leaves the leading set between two points does not change the sign:
+  // the sign changes where, and only where, a real multiplier crosses ±1.
+  double shifted_determinant(double target) const;
 };
 
 // All eigenvalues of a dense monodromy, sorted. Throws InputError for a non-square or non-finite

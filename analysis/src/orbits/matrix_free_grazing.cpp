@@ -1,0 +1,186 @@
+#include "orbits/matrix_free_grazing.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "orbits/bordered_krylov.hpp"
+#include "pwl/errors.hpp"
+
+namespace pwl::orbits::curves_detail {
+
+namespace {
+// The relative step of the central differences in a parameter (as the dense system takes them).
+constexpr double kParameterStep = 1e-6;
+// GMRES's relative residual for a tangent (as the one-parameter continuation asks).
+constexpr double kTangentTolerance = 1e-10;
+}  // namespace
+
+MatrixFreeGrazing::MatrixFreeGrazing(PlaneMaps& maps, int period, Index n, double p_scale,
+                                     double q_scale, int spring, bool at_largest, double p0,
+                                     double q0)
+    : GrazingSystem(maps, period, n, p_scale, q_scale, spring, at_largest) {
+  if (maps.options().shooting.precondition) {
+    StroboscopicMap& map = maps.at(p0, q0);
+    open_.emplace(map.structure(), period * map.forcing_period());
+  }
+}
+
+const detail::OpenStructurePreconditioner* MatrixFreeGrazing::open_at(double p, double q) {
+  if (!open_ || !open_->available()) return nullptr;
+  const double tau = period_ * maps_.at(p, q).forcing_period();
+  if (tau != open_->time()) open_->retime(tau);
+  return &*open_;
+}
+
+bool MatrixFreeGrazing::residuals(const Vector& u, Linearised& l) {
+  const Vector y = u.head(n_);
+  const double p = this->p(u), q = this->q(u);
+  try {
+    l.F = maps_.advance(y, p, q, period_) - y;
+    const GapExtreme e = maps_.gap_extreme(y, p, q, period_, spring_, at_largest_);
+    l.gamma = e.value;
+    const double end = period_ * maps_.at(p, q).forcing_period();
+    l.t = std::clamp(maps_.on_grid(p, q, e.time), 0.0, end);
+    // Last on this map: the state at t records the first arc, which the products replay.
+    l.at_t = maps_.flow(y, p, q, l.t);
+  } catch (const Error&) {
+    return false;
+  }
+  return l.F.allFinite() && std::isfinite(l.gamma) && l.at_t.allFinite();
+}
+
+bool MatrixFreeGrazing::linearise(const Vector& u, Linearised& l) {
+  const Vector y = u.head(n_);
+  const double p = this->p(u), q = this->q(u);
+  const Index dofs = n_ / 2;
+  try {
+    const double dp = kParameterStep * std::max(1.0, std::abs(p));
+    const double dq = kParameterStep * std::max(1.0, std::abs(q));
+    l.B.resize(n_, 2);
+    l.B.col(0) = (maps_.advance(y, p + dp, q, period_) - maps_.advance(y, p - dp, q, period_)) *
+                 (p_scale_ / (2 * dp));
+    l.B.col(1) = (maps_.advance(y, p, q + dq, period_) - maps_.advance(y, p, q - dq, period_)) *
+                 (q_scale_ / (2 * dq));
+    // γ at fixed t (the envelope theorem): the gap at t of the perturbed structures.
+    const Vector w = maps_.at(p, q).structure().spring_directions().col(spring_);
+    const auto gap_at = [&](double pp, double qq) {
+      const double gap = maps_.at(pp, qq).structure().spring_gaps()(spring_);
+      return w.dot(maps_.flow(y, pp, qq, l.t).head(dofs)) - gap;
+    };
+    l.gamma_p = (gap_at(p + dp, q) - gap_at(p - dp, q)) * (p_scale_ / (2 * dp));
+    l.gamma_q = (gap_at(p, q + dq) - gap_at(p, q - dq)) * (q_scale_ / (2 * dq));
+  } catch (const Error&) {
+    return false;
+  }
+  return l.B.allFinite() && std::isfinite(l.gamma_p) && std::isfinite(l.gamma_q);
+}
+
+bool MatrixFreeGrazing::solve(const Vector& u, const Linearised& l, const Vector& tau,
+                              const Vector& r, const Vector& rho, Vector& delta,
+                              double tolerance) {
+  const Vector y = u.head(n_);
+  const double p = this->p(u), q = this->q(u);
+  const Index dofs = n_ / 2;
+  const ShootingOptions& shooting = maps_.options().shooting;
+  try {
+    StroboscopicMap& second = maps_.second_at(p, q);
+    StroboscopicMap& first = maps_.at(p, q);
+    const detail::OpenStructurePreconditioner* open = open_at(p, q);
+    const double end = period_ * first.forcing_period();
+    const bool whole_first = l.t >= end * (1 - 1e-12);
+    const Vector w = first.structure().spring_directions().col(spring_);
+    CurvesResult& counts = maps_.result();
+    // [M v; ∇γᵀ v]: Φ(t) v, then on from t to the period's end.
+    const auto product = [&](const Vector& v) -> Vector {
+      Matrix V = v;
+      if (l.t > 0) first.flow(y, 0.0, whole_first ? end : l.t, &V);
+      const double row = w.dot(V.col(0).head(dofs));
+      if (!whole_first) second.flow(l.at_t, l.t, end, &V);
+      ++counts.krylov_products;
+      Vector out(n_ + 1);
+      out << V.col(0), row;
+      return out;
+    };
+    Matrix C = Matrix::Zero(n_, 2);
+    C.col(1) = tau.head(n_);
+    Matrix D(2, 2);
+    D << l.gamma_p, l.gamma_q, tau(n_), tau(n_ + 1);
+    const detail::BorderedKrylov system(product, open, l.B, C, D, 1);
+    Vector x, s;
+    system.solve(r, rho, x, s, tolerance, shooting.gmres_dimension, shooting.gmres_restarts);
+    delta.resize(n_ + 2);
+    delta << x, s;
+  } catch (const Error&) {
+    return false;
+  }
+  return delta.allFinite();
+}
+
+std::optional<MatrixFreeGrazing::Corrected> MatrixFreeGrazing::correct(const Vector& guess,
+                                                                       const Vector& prediction,
+                                                                       const Vector& tau,
+                                                                       int iterations,
+                                                                       double polish) {
+  const double tolerance_rel = maps_.options().shooting.tolerance;
+  Vector u = guess;
+  std::optional<Corrected> best;
+  double previous = std::numeric_limits<double>::infinity();
+  for (int it = 0;; ++it) {
+    if (!admissible(u)) break;
+    Linearised l;
+    if (!residuals(u, l)) break;
+    const double scale = this->scale(u);
+    const double res = std::max(l.F.lpNorm<Eigen::Infinity>(), std::abs(l.gamma));
+    const double arc = tau.dot(u - prediction);
+    const double tolerance = tolerance_rel * scale;
+    if (res <= tolerance && std::abs(arc) <= tolerance) {
+      if (!best || res < best->residual) best = Corrected{u, res, it};
+      if (polish <= 0 || res <= polish * scale || res > 0.25 * previous) break;
+    } else if (res > 4 * previous) {
+      break;  // diverging
+    }
+    if (it == iterations) break;
+    if (!linearise(u, l)) break;
+    const double target = polish > 0 ? std::min(tolerance, polish * scale) : tolerance;
+    const double eta = std::clamp(0.5 * target / std::max(res, 1e-300), 1e-10, 1e-2);
+    Vector rho(2);
+    rho << -l.gamma, -arc;
+    Vector delta;
+    if (!solve(u, l, tau, -l.F, rho, delta, eta)) break;
+    u += delta;
+    previous = res;
+  }
+  return best;
+}
+
+Vector MatrixFreeGrazing::tangent(const Vector& u, const Vector& previous) {
+  const Vector failed = Vector::Constant(u.size(), std::numeric_limits<double>::quiet_NaN());
+  Linearised l;
+  if (!residuals(u, l) || !linearise(u, l)) return failed;
+  Vector rho(2);
+  rho << 0.0, 1.0;
+  Vector z;
+  if (!solve(u, l, previous, Vector::Zero(n_), rho, z, kTangentTolerance)) return failed;
+  const double norm = z.norm();
+  if (!(norm > 0) || !std::isfinite(norm)) return failed;
+  z /= norm;
+  return z.dot(previous) < 0 ? Vector(-z) : z;
+}
+
+FloquetMultipliers MatrixFreeGrazing::multipliers(const Vector& u, const Eigen::MatrixXcd* warm,
+                                                  Eigen::MatrixXcd* ritz) {
+  const Vector y = u.head(n_);
+  StroboscopicMap& map = maps_.at(p(u), q(u));
+  ArnoldiOptions arnoldi = maps_.options().shooting.arnoldi;
+  arnoldi.block = map.tangent_block();
+  CurvesResult& counts = maps_.result();
+  return leading_floquet_multipliers(
+      [&](Matrix& v) {
+        map.advance(y, period_, v);
+        counts.arnoldi_products += v.cols();
+      },
+      n_, arnoldi, warm, ritz);
+}
+
+}  // namespace pwl::orbits::curves_detail

@@ -1,0 +1,85 @@
+#pragma once
+// The grazing curve of one spring without the monodromy: the defining system of GrazingSystem
+// (the orbit's equations F(y; p, q) = φ_kT(y) − y = 0 and γ(y; p, q) = 0, γ the largest or
+// smallest value of the spring's gap function along the orbit) corrected by Newton–Krylov, for
+// the structures whose monodromy is too large to form (a chain of a thousand masses and more).
+//
+// Each Newton step solves the doubly bordered system
+//
+//     [ M − I   ∂F/∂p̂   ∂F/∂q̂ ] [ δy ]     [ F   ]
+//     [ ∇γᵀ     ∂γ/∂p̂   ∂γ/∂q̂ ] [ δp̂ ] = − [ γ   ]
+//     [ τ_yᵀ    τ_p̂     τ_q̂   ] [ δq̂ ]     [ arc ]
+//
+// by GMRES (bordered_krylov.hpp, two borders). M is known by its products; so is the row ∇γᵀ: by
+// the envelope theorem (ġ = 0 at the extreme's time t*) ∇γᵀ v = e_sᵀ Φ(t*) v, the gap direction
+// of spring s times the state transition matrix at t*, a forward tangent integration to t*. A
+// product is one tangent integration over the period split at t*, Φ(kT) v = Φ(kT, t*) Φ(t*) v,
+// which gives both at the cost of one: the two arcs are carried by two maps of the same (p, q), so
+// that each records its arc once per Newton step and replays it for the products that follow
+// (StroboscopicMap). The preconditioner takes ∇γ as unknown (zero): it differs from the operator
+// by that one row, which costs GMRES about one product. The parameter columns, ∂γ/∂p̂ and ∂γ/∂q̂
+// come from central differences (4 integrations over the period, 4 to t*), as in the dense system.
+// A fixed-grid method stops at the grid time nearest t*: the row is then an approximation, which
+// slows Newton to a linear rate without moving the solution (γ itself is the extreme located on
+// the exact motion).
+//
+// The inexact Newton forcing (the relative residual GMRES is asked for tightens as the residual
+// falls) is that of the one-parameter matrix-free continuation: S. C. Eisenstat and H. F. Walker,
+// SIAM J. Sci. Comput. 17 (1996) 16-32. The bordered form of periodic-orbit continuation without
+// the monodromy: K. Lust, D. Roose, A. Spence and A. R. Champneys, SIAM J. Sci. Comput. 19 (1998)
+// 1188-1209. The grazing condition as a defining system: F. Colombo and F. Dercole, SIAM J. Appl.
+// Dyn. Syst. 9(1), 2010.
+#include <optional>
+
+#include "orbits/curve_systems.hpp"
+#include "orbits/open_structure_preconditioner.hpp"
+#include "pwl/orbits/floquet_multipliers.hpp"
+
+namespace pwl::orbits::curves_detail {
+
+class MatrixFreeGrazing : public GrazingSystem {
+ public:
+  MatrixFreeGrazing(PlaneMaps& maps, int period, Index n, double p_scale, double q_scale,
+                    int spring, bool at_largest, double p0, double q0);
+
+  struct Corrected {
+    Vector u;
+    double residual = 0.0;  // max(|F|∞, |γ|)
+    int iterations = 0;
+  };
+  // G(u) = 0 with τ · (u − prediction) = 0 from `guess` by Newton–Krylov: at most `iterations`
+  // steps, to the shooting tolerance (relative to the state's size), polished on to `polish` while
+  // each step shrinks the residual fourfold (CorrectorSettings::polish). Empty where it does not
+  // converge, the motion cannot be integrated or u leaves the domain.
+  std::optional<Corrected> correct(const Vector& guess, const Vector& prediction,
+                                   const Vector& tau, int iterations, double polish);
+  // The unit tangent of the curve at u, oriented like `previous`: [∂G/∂u; previousᵀ] z = e_last.
+  // Not finite where GMRES fails.
+  Vector tangent(const Vector& u, const Vector& previous);
+  // The leading multipliers of the orbit at u by Arnoldi (ShootingOptions::arnoldi), warm-started
+  // from `warm` (Ritz vectors of a point nearby); its Ritz vectors into `ritz`.
+  FloquetMultipliers multipliers(const Vector& u, const Eigen::MatrixXcd* warm,
+                                 Eigen::MatrixXcd* ritz);
+
+ private:
+  // What a Newton step or a tangent needs at u: the residuals, the extreme's (grid) time and the
+  // state there, the parameter columns and ∂γ.
+  struct Linearised {
+    Vector F;
+    double gamma = 0.0;
+    double t = 0.0;
+    Vector at_t;     // the state at t
+    Matrix B;        // n × 2: ∂F/∂p̂, ∂F/∂q̂
+    double gamma_p = 0.0, gamma_q = 0.0;
+  };
+  bool residuals(const Vector& u, Linearised& l);
+  bool linearise(const Vector& u, Linearised& l);
+  // Solves [J; τᵀ] [δ] = [r; ρ] (J: the system's Jacobian at u, as linearised).
+  bool solve(const Vector& u, const Linearised& l, const Vector& tau, const Vector& r,
+             const Vector& rho, Vector& delta, double tolerance);
+  const detail::OpenStructurePreconditioner* open_at(double p, double q);
+
+  std::optional<detail::OpenStructurePreconditioner> open_;
+};
+
+}  // namespace pwl::orbits::curves_detail
