@@ -168,6 +168,16 @@ struct Test {
   bool at_largest = true;
 };
 
+// Whether curves of n state components may form the monodromy: the solver dense, or automatic
+// within the dense limit; krylov (`krylov_counts`) or automatic beyond the limit are matrix-free,
+// which only grazing curves can be. Fold, period-doubling and Neimark–Sacker curves are dense
+// whatever the solver where they may be (`krylov_counts` false: krylov within the limit).
+bool dense_allowed(const ShootingOptions& s, Index n, bool krylov_counts = false) {
+  if (s.solver == ShootingSolver::dense) return true;
+  if (krylov_counts && s.solver == ShootingSolver::krylov) return false;
+  return n <= s.dense_state_limit;
+}
+
 std::string gap_detail(int spring, bool at_largest) {
   return fmt::format("spring {} ({} gap)", spring + 1, at_largest ? "largest" : "smallest");
 }
@@ -234,12 +244,12 @@ class CurvesRunner {
     summary.spring = b.spring;
     summary.at_largest_gap = b.at_largest_gap;
     const Index n = b.state.size();
-    if (summary.type != CurveType::grazing && n > options_.shooting.dense_state_limit) {
-      note(fmt::format("curve {} ({} at {} = {:.10g}): not followed: its defining system forms the "
-                       "{}x{} monodromy, beyond the dense limit of {} state components (only "
-                       "grazing curves are matrix-free)",
-                       id, curve_type_name(summary.type), options_.first.name(), b.parameter, n,
-                       n, options_.shooting.dense_state_limit));
+    if (summary.type != CurveType::grazing && !dense_allowed(options_.shooting, n)) {
+      note(fmt::format("the {} at {} = {:.10g}: its curve is not followed: its defining system "
+                       "forms the {}x{} monodromy, beyond the dense limit of {} state components "
+                       "(only grazing curves are matrix-free)",
+                       bifurcation_name(b.type), options_.first.name(), b.parameter, n, n,
+                       options_.shooting.dense_state_limit));
       return;
     }
     chord_ = options_.corrector == Corrector::chord ||
@@ -269,6 +279,7 @@ class CurvesRunner {
     at_largest_ = b.at_largest_gap;
     tests_ = tests_of(type_);
     unreliable_noted_ = false;
+    untrusted_noted_ = false;
     // The first point: the curve's equations with q held at the branch's value.
     const Vector guess = system->unknowns(b.state, b.parameter, q0_, aux);
     Vector hold = Vector::Zero(guess.size());
@@ -299,6 +310,7 @@ class CurvesRunner {
     bool closed = false;
     for (int direction = 0; direction < 2 && !closed; ++direction) {
       CurvePt start = *first;
+      warm_ = first->ritz;  // each direction's Arnoldi warm-started from the curve's first point
       if (direction == 1) {
         start.tangent = -first->tangent;
         emit(*first);  // each direction's rows start at the curve's first point
@@ -468,11 +480,7 @@ class CurvesRunner {
 
   // Whether a grazing curve of n state components is followed matrix-free: where the solver is
   // krylov, or automatic beyond the dense limit.
-  bool matrix_free(Index n) const {
-    const ShootingOptions& s = options_.shooting;
-    return s.solver == ShootingSolver::krylov ||
-           (s.solver == ShootingSolver::automatic && n > s.dense_state_limit);
-  }
+  bool matrix_free(Index n) const { return !dense_allowed(options_.shooting, n, true); }
 
   // The unit tangent at a corrected point, oriented like `previous`.
   Vector tangent_at(const CurvePt& pt, const Vector& previous) {
@@ -496,7 +504,11 @@ class CurvesRunner {
       pt.residual = c->residual;
       pt.iterations = c->iterations;
       pt.mu = free_->multipliers(pt.u, warm_.size() > 0 ? &warm_ : nullptr, &pt.ritz);
-      if (!pt.mu.converged) ++result_.unconverged_multipliers;
+      if (!pt.mu.converged) {
+        ++result_.unconverged_multipliers;
+      } else if (!pt.mu.band_covered) {
+        ++result_.uncovered_bands;
+      }
       pt.tests = evaluate_tests(pt);
       return pt;
     }
@@ -517,9 +529,28 @@ class CurvesRunner {
   std::vector<double> evaluate_tests(CurvePt& pt) {
     std::vector<double> values;
     values.reserve(tests_.size());
+    // Matrix-free: the multipliers' tests rest on Arnoldi having converged and reported every
+    // multiplier outside the circle; where it did not, they are not evaluated (as the branch does
+    // not claim a stability change there), and the curve says so once.
+    const bool trusted = pt.mu.converged && pt.mu.band_covered;
+    if (!trusted && !untrusted_noted_) {
+      note(fmt::format("curve {}: at {} = {:.10g}, {} = {:.10g} Arnoldi {}: no fold-, flip- or "
+                       "Neimark-Sacker-grazing point is looked for where that holds",
+                       curve_, options_.first.name(), system_->p(pt.u), options_.second.name(),
+                       system_->q(pt.u),
+                       pt.mu.converged ? "did not reach below the band of multipliers it must cover"
+                                       : "stopped short of its tolerance"));
+      untrusted_noted_ = true;
+    }
     for (const Test& t : tests_) {
       using K = Test::Kind;
       double v = kNaN;
+      const bool multipliers = t.kind != K::kappa && t.kind != K::gap && t.kind != K::cusp &&
+                               t.kind != K::generalised_pd;
+      if (multipliers && !trusted) {
+        values.push_back(v);
+        continue;
+      }
       switch (t.kind) {
         case K::det_minus: v = pt.mu.shifted_determinant(1.0); break;
         case K::det_plus: v = pt.mu.shifted_determinant(-1.0); break;
@@ -912,6 +943,7 @@ class CurvesRunner {
   std::vector<Crossing> crossings_;  // of the branch's Q, by every curve so far
   int springs_ = 0;
   bool unreliable_noted_ = false;
+  bool untrusted_noted_ = false;  // a note said where the multipliers could not be trusted
 };
 
 }  // namespace
@@ -953,8 +985,7 @@ CurvesResult follow_bifurcation_curves(const analysis::PointModel& model,
     if (std::find(options.types.begin(), options.types.end(), type) == options.types.end()) {
       continue;
     }
-    any = any || type == CurveType::grazing ||
-          start.state.size() <= options.shooting.dense_state_limit;
+    any = any || type == CurveType::grazing || dense_allowed(options.shooting, start.state.size());
   }
   if (!any) {
     throw InputError(fmt::format(

@@ -80,7 +80,8 @@ class BorderedKrylov {
       }
     }
   }
-  // One border: [M − I, b; cᵀ, d].
+  // One border: [M − I, b; cᵀ, d] (the same algorithm as with k borders; the pivot's division is a
+  // product with its inverse, equal to rounding).
   BorderedKrylov(std::function<Vector(const Vector&)> product,
                  const OpenStructurePreconditioner* open, const Vector& b, const Vector& c,
                  double d)

@@ -28,7 +28,13 @@ StroboscopicMap& PlaneMaps::cached(std::map<std::pair<double, double>, Strobosco
   const auto key = std::make_pair(p, q);
   auto it = cache.find(key);
   if (it != cache.end()) return it->second;
-  if (cache.size() > most) cache.clear();
+  if (cache.size() > most) {
+    // The pinned map's node is taken out and put back: the map itself (and what it recorded)
+    // stays where it is.
+    auto kept = pinned_ ? cache.extract(*pinned_) : decltype(cache.extract(key)){};
+    cache.clear();
+    if (kept) cache.insert(std::move(kept));
+  }
   const analysis::PointModel point = model_.with(options_.first, p).with(options_.second, q);
   return cache
       .emplace(key, StroboscopicMap(point.point_case(), options_.method, options_.steps_per_period))

@@ -38,6 +38,9 @@ class PlaneMaps {
   // A second map of (p, q): where products alternate between two arcs of one orbit (up to a time
   // within the period and on from there), each map records and replays its own arc.
   StroboscopicMap& second_at(double p, double q);
+  // Keeps the maps of (p, q) (both caches) when a cache is emptied: a caller that integrates at
+  // nearby parameters between the products at (p, q) keeps what the maps of (p, q) recorded.
+  void pin(double p, double q) { pinned_ = std::make_pair(p, q); }
   const CurvesOptions& options() const { return options_; }
   CurvesResult& result() { return result_; }
 
@@ -46,8 +49,9 @@ class PlaneMaps {
   const CurvesOptions& options_;
   CurvesResult& result_;
   std::map<std::pair<double, double>, StroboscopicMap> maps_, seconds_;
-  // The map of (p, q) from `cache`, built there when missing (the cache emptied first when it
-  // holds more than `most`).
+  std::optional<std::pair<double, double>> pinned_;
+  // The map of (p, q) from `cache`, built there when missing (the cache emptied first, but for
+  // the pinned map, when it holds more than `most`).
   StroboscopicMap& cached(std::map<std::pair<double, double>, StroboscopicMap>& cache,
                           std::size_t most, double p, double q);
 };

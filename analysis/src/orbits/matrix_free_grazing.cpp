@@ -34,8 +34,13 @@ const detail::OpenStructurePreconditioner* MatrixFreeGrazing::open_at(double p, 
 }
 
 bool MatrixFreeGrazing::residuals(const Vector& u, Linearised& l) {
+  if (last_at_.size() == u.size() && last_at_ == u) {
+    l = last_;
+    return true;
+  }
   const Vector y = u.head(n_);
   const double p = this->p(u), q = this->q(u);
+  maps_.pin(p, q);
   try {
     l.F = maps_.advance(y, p, q, period_) - y;
     const GapExtreme e = maps_.gap_extreme(y, p, q, period_, spring_, at_largest_);
@@ -47,7 +52,10 @@ bool MatrixFreeGrazing::residuals(const Vector& u, Linearised& l) {
   } catch (const Error&) {
     return false;
   }
-  return l.F.allFinite() && std::isfinite(l.gamma) && l.at_t.allFinite();
+  if (!(l.F.allFinite() && std::isfinite(l.gamma) && l.at_t.allFinite())) return false;
+  last_ = l;
+  last_at_ = u;
+  return true;
 }
 
 bool MatrixFreeGrazing::linearise(const Vector& u, Linearised& l) {
@@ -102,11 +110,14 @@ bool MatrixFreeGrazing::solve(const Vector& u, const Linearised& l, const Vector
       out << V.col(0), row;
       return out;
     };
+    // The gap's row: known only by its products, but at t = 0 it is the gap direction itself.
     Matrix C = Matrix::Zero(n_, 2);
     C.col(1) = tau.head(n_);
+    const bool row_known = !(l.t > 0);
+    if (row_known) C.col(0).head(dofs) = w;
     Matrix D(2, 2);
     D << l.gamma_p, l.gamma_q, tau(n_), tau(n_ + 1);
-    const detail::BorderedKrylov system(product, open, l.B, C, D, 1);
+    const detail::BorderedKrylov system(product, open, l.B, C, D, row_known ? 0 : 1);
     Vector x, s;
     system.solve(r, rho, x, s, tolerance, shooting.gmres_dimension, shooting.gmres_restarts);
     delta.resize(n_ + 2);

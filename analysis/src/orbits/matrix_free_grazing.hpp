@@ -16,12 +16,19 @@
 // product is one tangent integration over the period split at t*, Φ(kT) v = Φ(kT, t*) Φ(t*) v,
 // which gives both at the cost of one: the two arcs are carried by two maps of the same (p, q), so
 // that each records its arc once per Newton step and replays it for the products that follow
-// (StroboscopicMap). The preconditioner takes ∇γ as unknown (zero): it differs from the operator
-// by that one row, which costs GMRES about one product. The parameter columns, ∂γ/∂p̂ and ∂γ/∂q̂
-// come from central differences (4 integrations over the period, 4 to t*), as in the dense system.
-// A fixed-grid method stops at the grid time nearest t*: the row is then an approximation, which
-// slows Newton to a linear rate without moving the solution (γ itself is the extreme located on
-// the exact motion).
+// (StroboscopicMap, where the integrator records). The preconditioner takes ∇γ as unknown (zero):
+// it differs from the operator by that one row, which costs GMRES about one product (at t* = 0
+// the row is the gap direction itself, and the preconditioner has it). The parameter columns, ∂γ/∂p̂ and ∂γ/∂q̂ come from
+// central differences (4 integrations over the period, 4 to t*), as in the dense system; the
+// maps of the point's (p, q) are pinned in their cache meanwhile, so that what they recorded
+// survives. A fixed-grid method stops at the grid time nearest t*: the row is then an
+// approximation, which slows Newton to a linear rate without moving the solution (γ itself is the
+// extreme as the orbit's profile locates it: on the exact motion for the exact solver, by
+// interpolation between the steps of a fixed-grid method, as for the dense system). Only an
+// integrator that records its tangent map (the banded switching PIM) replays; for the others each
+// product integrates both arcs. The open structure's inverse is built at the curve's start and
+// retimed to each point's forcing period; where Q changes the linear structure (its damping,
+// masses or stiffnesses) it is that of the start, which only slows GMRES.
 //
 // The inexact Newton forcing (the relative residual GMRES is asked for tightens as the residual
 // falls) is that of the one-parameter matrix-free continuation: S. C. Eisenstat and H. F. Walker,
@@ -80,6 +87,9 @@ class MatrixFreeGrazing : public GrazingSystem {
   const detail::OpenStructurePreconditioner* open_at(double p, double q);
 
   std::optional<detail::OpenStructurePreconditioner> open_;
+  // The residuals of the last u evaluated (the tangent at a corrected point reuses them).
+  Linearised last_;
+  Vector last_at_;
 };
 
 }  // namespace pwl::orbits::curves_detail

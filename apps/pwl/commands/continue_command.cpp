@@ -482,10 +482,11 @@ void continue_orbit(const ContinueFlags& f) {
     if (curves.krylov_products > 0 || curves.arnoldi_products > 0) {
       fmt::print("  matrix-free grazing curves: {} GMRES products, {} Arnoldi products\n",
                  curves.krylov_products, curves.arnoldi_products);
-      if (curves.unconverged_multipliers > 0) {
-        fmt::print("  at {} point(s) Arnoldi stopped short of its tolerance: the codimension-two "
-                   "tests there rest on unconverged Ritz values\n",
-                   curves.unconverged_multipliers);
+      if (curves.unconverged_multipliers > 0 || curves.uncovered_bands > 0) {
+        fmt::print("  at {} corrected point(s) Arnoldi stopped short of its tolerance and at {} it "
+                   "did not reach below every multiplier outside the circle: no fold-, flip- or "
+                   "Neimark-Sacker-grazing point is looked for there\n",
+                   curves.unconverged_multipliers, curves.uncovered_bands);
       }
     }
     fmt::print("curves' time: {:.2f} s ({} rows)\n",

@@ -48,14 +48,16 @@
 // kept.
 //
 // Dense or matrix-free. Fold, period-doubling and Neimark–Sacker curves form the monodromy (up to
-// ShootingOptions::dense_state_limit state components; beyond it they are noted and not
-// followed). A grazing curve is followed matrix-free beyond the dense limit, or wherever
-// ShootingOptions::solver is krylov: Newton–Krylov on its doubly bordered system, the gap's
+// ShootingOptions::dense_state_limit state components, or at any size where the solver is dense;
+// beyond it they are noted and not followed). A grazing curve is followed matrix-free beyond the
+// dense limit (unless the solver is dense), or wherever ShootingOptions::solver is krylov: Newton–Krylov on its doubly bordered system, the gap's
 // gradient known only by its products (matrix_free_grazing.hpp), and the leading multipliers by
 // Arnoldi for the codimension-two tests: det(I ∓ M) over the leading multipliers for the
 // fold–grazing and period-doubling–grazing points, which changes sign where the full determinant
 // does (FloquetMultipliers::shifted_determinant), and the same double-grazing and
-// Neimark–Sacker–grazing tests as dense.
+// Neimark–Sacker–grazing tests as dense. Where Arnoldi did not converge or did not reach below
+// every multiplier outside the circle, the multipliers' tests are not evaluated (a note says
+// where), as the branch claims no stability change there.
 #include <complex>
 #include <string>
 #include <vector>
@@ -143,7 +145,8 @@ struct CurvesResult {
   // its tolerance.
   long krylov_products = 0;
   long arnoldi_products = 0;
-  int unconverged_multipliers = 0;
+  int unconverged_multipliers = 0;  // corrected points (trial points of a location included)
+  int uncovered_bands = 0;          // converged, but not below every multiplier outside the circle
 };
 
 // Hooks for writing as the curves grow (every hook optional).
