@@ -137,6 +137,22 @@ FloquetMultipliers multipliers_at(NondimensionalChain chain, double theta, doubl
   return floquet_multipliers(M);
 }
 
+// Figure 5's chain (α = 5) at θ.
+NondimensionalChain figure5_from(double theta) {
+  NondimensionalChain chain = paper_five_dof_case("5");
+  chain.theta = theta;
+  return chain;
+}
+
+// The one grazing its branch from θ = 1.45 to 1.5 locates: spring 3 at θ = 1.4837.
+std::vector<Bifurcation> spring3_grazing() {
+  const std::vector<Bifurcation> grazings =
+      located_in(branch(figure5_from(1.45), 1.45, 1.5), BifurcationType::grazing);
+  REQUIRE(grazings.size() == 1);
+  REQUIRE(grazings[0].spring == 2);
+  return grazings;
+}
+
 }  // namespace
 
 TEST_CASE("grazing curves of a contact-free branch follow the closed form, and meet in a double "
@@ -413,13 +429,8 @@ TEST_CASE("a matrix-free grazing curve through motion with contact agrees with o
   // doublings. Its curve in (θ, α) meets a Neimark–Sacker curve near α = 4.74 and a
   // period-doubling curve near α = 5.41.
   const NondimensionalChain chain = paper_five_dof_case("5");
-  NondimensionalChain start = chain;
-  start.theta = 1.45;
-  const std::vector<Bifurcation> grazings =
-      located_in(branch(chain, 1.45, 1.5), BifurcationType::grazing);
-  REQUIRE(grazings.size() == 1);
-  REQUIRE(grazings[0].spring == 2);
-  const analysis::PointModel model(start);
+  const std::vector<Bifurcation> grazings = spring3_grazing();
+  const analysis::PointModel model(figure5_from(1.45));
   const CurvesResult r = follow_bifurcation_curves(
       model, grazings, mf_grazing_options(true));
   const CurvesResult dense = follow_bifurcation_curves(
@@ -536,13 +547,8 @@ TEST_CASE("on a fixed-grid method that records its tangent map, the matrix-free 
   // of the matrix-free system, against the dense system on the same method. Spring 3's grazing
   // curve of figure 5's chain crosses the α range [4.5, 5.5]: its two ends on the edges (each
   // located to 1e-10) and its Neimark–Sacker–grazing point agree to 1e-8.
-  const NondimensionalChain chain = paper_five_dof_case("5");
-  NondimensionalChain start = chain;
-  start.theta = 1.45;
-  const std::vector<Bifurcation> grazings =
-      located_in(branch(chain, 1.45, 1.5), BifurcationType::grazing);
-  REQUIRE(grazings.size() == 1);
-  const analysis::PointModel model(start);
+  const std::vector<Bifurcation> grazings = spring3_grazing();
+  const analysis::PointModel model(figure5_from(1.45));
   CurvesResult r[2];
   for (const bool matrix_free : {false, true}) {
     CurvesOptions o = mf_grazing_options(matrix_free);
