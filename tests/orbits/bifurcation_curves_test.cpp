@@ -442,8 +442,7 @@ TEST_CASE("a matrix-free grazing curve through motion with contact agrees with o
   for (const std::string& end : r.curves[0].ends) CHECK(end.find("left the alpha range") == 0);
 
   // Five points: the one-parameter continuation in θ at their α locates spring 3's grazing there.
-  std::vector<const CurvePointRecord*> rows;
-  for (const CurvePointRecord& p : r.points) rows.push_back(&p);
+  const auto rows = rows_of(r, 0);
   REQUIRE(rows.size() >= 12);
   int compared = 0;
   for (std::size_t i = 1; i < rows.size() && compared < 5; i += rows.size() / 6) {
