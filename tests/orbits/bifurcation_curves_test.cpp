@@ -18,14 +18,21 @@
 // contact (figure 5's chain in (θ, α)) whose points one-parameter continuations in θ locate to
 // 1e-8, whose Neimark–Sacker–grazing point has a pair of the dense monodromy on the circle and lies
 // where the dense curve puts it, and whose period-doubling–grazing point has a multiplier at −1;
-// beyond the dense limit grazing curves followed and the others noted, and a run with none to
-// follow refused naming the limit.
+// on the banded switching PIM (recorded, replayed arcs; a grid) the dense curve.
+// Fold, period-doubling and Neimark–Sacker curves matrix-free (Newton–Krylov on the bordered test
+// functions, their rows known by directional derivatives): figure 5's period-doubling curve
+// through a 1:2 resonance and a fold–flip point, the hardening oscillator's fold curve through its
+// cusp, and the Neimark–Sacker curves of figure 5's chain through a 1:4 and to a 1:2 resonance,
+// against the dense curves and the dense monodromy along them. Beyond a dense limit below the
+// chain's size every curve followed, none forming a monodromy.
 #include <catch2/catch.hpp>
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <functional>
 
+#include "curve_cases.hpp"
 #include "orbit_cases.hpp"
 #include "pwl/errors.hpp"
 #include "pwl/model/chain_builders.hpp"
@@ -503,39 +510,34 @@ TEST_CASE("a matrix-free grazing curve through motion with contact agrees with o
   CHECK(std::abs(pd->p - pd_dense->p) <= 1e-7);
 }
 
-TEST_CASE("beyond the dense limit grazing curves are followed matrix-free, the others noted, "
-          "and a run with none to follow refused",
-          "[orbits][curves]") {
+TEST_CASE("beyond the dense limit every curve is followed matrix-free", "[orbits][curves]") {
   const NondimensionalChain chain = paper_five_dof_case("5");
-  NondimensionalChain start = chain;
-  start.theta = 1.45;
   const ContinuationResult b = branch(chain, 1.45, 1.5);
   std::vector<Bifurcation> starts;
   for (const Bifurcation& x : b.bifurcations) {
     if (x.located && x.branch == 0) starts.push_back(x);
   }
-  const std::vector<Bifurcation> doublings =
-      located_in(b, BifurcationType::period_doubling);
-  REQUIRE(doublings.size() == 2);
-  CurvesOptions o = mf_grazing_options(false);
-  o.types = {CurveType::period_doubling, CurveType::grazing};
+  REQUIRE(located_in(b, BifurcationType::period_doubling).size() == 2);
+  REQUIRE(located_in(b, BifurcationType::grazing).size() == 1);
+  const std::vector<Bifurcation> ns =
+      located_in(branch(chain, 2.59, 2.62), BifurcationType::neimark_sacker);
+  REQUIRE(ns.size() == 1);
+  starts.push_back(ns[0]);
+  CurvesOptions o = curves_options(1.4, 2.7, SweepParameter::alpha, 4.5, 5.5,
+                                   {CurveType::period_doubling, CurveType::grazing,
+                                    CurveType::neimark_sacker});
   o.shooting.dense_state_limit = 8;  // below the chain's 10 state components
   o.max_points = 5;
-  const CurvesResult r = follow_bifurcation_curves(analysis::PointModel(start), starts, o);
-  REQUIRE(r.curves.size() == 1);
-  CHECK(r.curves[0].type == CurveType::grazing);
+  const CurvesResult r = follow_bifurcation_curves(analysis::PointModel(chain), starts, o);
+  REQUIRE(r.curves.size() == 4);
+  int types[4] = {0, 0, 0, 0};
+  for (const CurveSummary& c : r.curves) ++types[static_cast<int>(c.type)];
+  CHECK(types[static_cast<int>(CurveType::period_doubling)] == 2);
+  CHECK(types[static_cast<int>(CurveType::grazing)] == 1);
+  CHECK(types[static_cast<int>(CurveType::neimark_sacker)] == 1);
   CHECK(r.monodromies == 0);
   CHECK(r.krylov_products > 0);
-  int noted = 0;
-  for (const std::string& n : r.notes) {
-    noted += n.find("not followed") != std::string::npos &&
-             n.find("dense limit of 8 state components") != std::string::npos;
-  }
-  CHECK(noted == 2);
-  o.types = {CurveType::period_doubling};
-  CHECK_THROWS_AS(follow_bifurcation_curves(analysis::PointModel(start), doublings, o), InputError);
-  CHECK_THROWS_WITH(follow_bifurcation_curves(analysis::PointModel(start), doublings, o),
-                    Catch::Contains("dense limit is 8 state components"));
+  CHECK(r.arnoldi_products > 0);
 }
 
 TEST_CASE("on a fixed-grid method that records its tangent map, the matrix-free grazing curve is "
@@ -559,18 +561,8 @@ TEST_CASE("on a fixed-grid method that records its tangent map, the matrix-free 
   CHECK(r[1].monodromies == 0);
   CHECK(r[1].krylov_products > 0);
   for (const double edge : {4.5, 5.5}) {
-    double p[2] = {0, 0};
-    int found[2] = {0, 0};
-    for (int k = 0; k < 2; ++k) {
-      for (const CurvePointRecord& row : r[k].points) {
-        if (std::abs(row.q - edge) <= 1e-9) p[k] = row.p, ++found[k];
-      }
-    }
-    INFO("alpha = " << edge);
-    REQUIRE(found[0] == 1);
-    REQUIRE(found[1] == 1);
-    measured("switching PIM: matrix-free - dense grazing curve theta at an edge", p[1] - p[0]);
-    CHECK(std::abs(p[1] - p[0]) <= 1e-8);
+    pwl::test::check_same_end(r[0], r[1], edge,
+                              "switching PIM: matrix-free - dense grazing curve theta at an edge");
   }
   const Codim2Point* ns[2] = {codim2_of(r[0], "neimark-sacker-grazing"),
                               codim2_of(r[1], "neimark-sacker-grazing")};
@@ -579,4 +571,186 @@ TEST_CASE("on a fixed-grid method that records its tangent map, the matrix-free 
   measured("switching PIM: matrix-free - dense NS-grazing alpha", ns[1]->q - ns[0]->q);
   CHECK(std::abs(ns[1]->p - ns[0]->p) <= 1e-8);
   CHECK(std::abs(ns[1]->q - ns[0]->q) <= 1e-8);
+}
+
+TEST_CASE("matrix-free period-doubling and fold curves are the dense ones, with their "
+          "codimension-two points",
+          "[orbits][curves]") {
+  // Figure 5's chain (α = 5): the period doubling at θ = 1.01 has a curve in (θ, α) that meets a
+  // 1:2 resonance near α = 2.95 and a fold-flip point near α = 7.84; the hardening oscillator's two
+  // folds are one curve in (θ, amplitude). Each followed dense and matrix-free (the solver forced
+  // to krylov: Newton–Krylov on the bordered test function, the multipliers by Arnoldi).
+  const NondimensionalChain chain = paper_five_dof_case("5");
+  const std::vector<Bifurcation> doublings =
+      located_in(branch(chain, 0.99, 1.03), BifurcationType::period_doubling);
+  REQUIRE(doublings.size() == 1);
+  CurvesResult pd[2];
+  for (const bool matrix_free : {false, true}) {
+    CurvesOptions o = curves_options(0.5, 2.5, SweepParameter::alpha, 2.5, 8.5,
+                                     {CurveType::period_doubling});
+    if (matrix_free) o.shooting.solver = ShootingSolver::krylov;
+    pd[matrix_free] = follow_bifurcation_curves(analysis::PointModel(chain), doublings, o);
+    REQUIRE(pd[matrix_free].curves.size() == 1);
+  }
+  CHECK(pd[1].monodromies == 0);
+  CHECK(pd[1].krylov_products > 0);
+  CHECK(pd[1].arnoldi_products > 0);
+  CHECK(pd[0].krylov_products == 0);
+  // Both curves cross the α range: their ends on its edges agree.
+  for (const double edge : {2.5, 8.5}) {
+    pwl::test::check_same_end(pd[0], pd[1], edge,
+                              "matrix-free - dense period-doubling curve theta at an edge");
+  }
+  // Along the matrix-free curve the dense monodromy has a multiplier at −1.
+  const auto rows = rows_of(pd[1], 0);
+  REQUIRE(rows.size() >= 12);
+  int compared = 0;
+  for (std::size_t i = 1; i < rows.size() && compared < 5; i += rows.size() / 6, ++compared) {
+    const CurvePointRecord& p = *rows[i];
+    double flip = 1e300;
+    for (const auto& m : multipliers_at(chain, p.p, p.q, p.state).values) {
+      flip = std::min(flip, std::abs(m + 1.0));
+    }
+    INFO("theta = " << p.p << ", alpha = " << p.q);
+    measured("matrix-free period-doubling curve: |mu + 1| of the dense monodromy", flip);
+    CHECK(flip <= 1e-8);
+  }
+  // The 1:2 resonance (two multipliers at −1) and the fold-flip point (one at −1, one at +1):
+  // where the dense curve puts them, and so by the dense monodromy at the matrix-free point. Near
+  // a double multiplier each of the pair is off −1 by about the square root of the point's error.
+  for (const std::string type : {"resonance-1:2", "fold-flip"}) {
+    INFO(type);
+    const Codim2Point* mf = codim2_of(pd[1], type);
+    const Codim2Point* dense = codim2_of(pd[0], type);
+    REQUIRE(mf != nullptr);
+    REQUIRE(dense != nullptr);
+    measured("matrix-free - dense " + type + " alpha", mf->q - dense->q);
+    measured("matrix-free - dense " + type + " theta", mf->p - dense->p);
+    CHECK(std::abs(mf->p - dense->p) <= 1e-8);
+    CHECK(std::abs(mf->q - dense->q) <= 1e-8);
+    std::vector<std::complex<double>> mu = multipliers_at(chain, mf->p, mf->q, mf->state).values;
+    const auto nearest = [&](std::complex<double> target) {
+      std::size_t best = 0;
+      for (std::size_t j = 1; j < mu.size(); ++j) {
+        if (std::abs(mu[j] - target) < std::abs(mu[best] - target)) best = j;
+      }
+      const double d = std::abs(mu[best] - target);
+      mu.erase(mu.begin() + static_cast<std::ptrdiff_t>(best));
+      return d;
+    };
+    const double first = nearest(-1.0);
+    const double second = nearest(type == "fold-flip" ? 1.0 : -1.0);
+    measured("matrix-free " + type + ": the dense monodromy's pair from -1 and " +
+                 (type == "fold-flip" ? "+1" : "-1"),
+             std::max(first, second));
+    const double bound = type == "fold-flip" ? 1e-8 : 1e-5;
+    CHECK(first <= bound);
+    CHECK(second <= bound);
+  }
+  CHECK(codim2_of(pd[1], "generalised-period-doubling") == nullptr);
+
+  // The hardening oscillator's fold curve (one mass: the leading multipliers are both).
+  const NondimensionalChain oscillator = pwl::test::hardening_oscillator(1.0);
+  std::vector<Bifurcation> folds = located_in(branch(oscillator, 0.8, 2.0), BifurcationType::fold);
+  REQUIRE(folds.size() == 2);
+  CurvesResult fold[2];
+  for (const bool matrix_free : {false, true}) {
+    CurvesOptions o =
+        curves_options(0.8, 2.0, SweepParameter::amplitude, 0.2, 2.0, {CurveType::fold});
+    if (matrix_free) o.shooting.solver = ShootingSolver::krylov;
+    fold[matrix_free] = follow_bifurcation_curves(analysis::PointModel(oscillator), folds, o);
+    // The second fold lies on the first one's curve.
+    REQUIRE(fold[matrix_free].curves.size() == 1);
+  }
+  CHECK(fold[1].monodromies == 0);
+  CHECK(fold[1].krylov_products > 0);
+  // Both ends leave the amplitude range at 2, on either side of the resonance, through the cusp
+  // between them: the same θ dense and matrix-free.
+  const std::vector<double> ends[2] = {pwl::test::curve_p_at(fold[0], 2.0),
+                                       pwl::test::curve_p_at(fold[1], 2.0)};
+  REQUIRE(ends[0].size() == 2);
+  REQUIRE(ends[1].size() == 2);
+  for (std::size_t k = 0; k < 2; ++k) {
+    measured("matrix-free - dense fold curve theta at amplitude 2", ends[1][k] - ends[0][k]);
+    CHECK(std::abs(ends[1][k] - ends[0][k]) <= 1e-8);
+  }
+  // Along the matrix-free curve the monodromy has a multiplier at +1.
+  const auto fold_rows = rows_of(fold[1], 0);
+  REQUIRE(fold_rows.size() >= 12);
+  compared = 0;
+  for (std::size_t i = 1; i < fold_rows.size() && compared < 5;
+       i += fold_rows.size() / 6, ++compared) {
+    const CurvePointRecord& p = *fold_rows[i];
+    NondimensionalChain at = oscillator;
+    at.theta = p.p;
+    for (double& q : at.amplitude) q *= p.q;
+    StroboscopicMap map(analysis::PointCase(at), MethodSettings{Method::exact}, 1);
+    Matrix M;
+    map.advance_with_jacobian(p.state, 1, M);
+    double to_one = 1e300;
+    for (const auto& m : floquet_multipliers(M).values) to_one = std::min(to_one, std::abs(m - 1.0));
+    INFO("theta = " << p.p << ", amplitude scale " << p.q);
+    measured("matrix-free fold curve: |mu - 1| of the dense monodromy", to_one);
+    CHECK(to_one <= 1e-8);
+  }
+  CHECK(codim2_of(fold[1], "cusp") == nullptr);
+  int noted = 0;
+  for (const std::string& n : fold[1].notes) noted += n.find("no cusp point is looked for") != std::string::npos;
+  CHECK(noted == 1);
+}
+
+TEST_CASE("matrix-free Neimark-Sacker curves are the dense ones, with their strong resonances",
+          "[orbits][curves]") {
+  // The two Neimark–Sacker curves of figure 5's chain of the resonances test above: from
+  // θ = 1.9118 up in α through a 1:4 resonance, from θ = 0.9920 down to the 1:2 resonance where
+  // it ends. Dense and matrix-free (Newton–Krylov on two entries of the bordered test matrix of
+  // M² − 2κM + I, the multipliers by Arnoldi): the resonances at the same (θ, α), and along the
+  // matrix-free curve a pair of the dense monodromy on the circle at the curve's angle.
+  const NondimensionalChain chain = paper_five_dof_case("5");
+  struct Case {
+    double from, to, q_from, q_to;
+    const char* resonance;
+  };
+  for (const Case& k : {Case{1.90, 1.92, 4.5, 9.0, "resonance-1:4"},
+                        Case{0.985, 1.0, 2.5, 5.5, "resonance-1:2"}}) {
+    INFO(k.resonance);
+    const std::vector<Bifurcation> starts =
+        located_in(branch(chain, k.from, k.to), BifurcationType::neimark_sacker);
+    REQUIRE(starts.size() == 1);
+    CurvesResult r[2];
+    for (const bool matrix_free : {false, true}) {
+      CurvesOptions o = curves_options(0.9, 2.2, SweepParameter::alpha, k.q_from, k.q_to,
+                                       {CurveType::neimark_sacker});
+      if (matrix_free) o.shooting.solver = ShootingSolver::krylov;
+      r[matrix_free] = follow_bifurcation_curves(analysis::PointModel(chain), starts, o);
+      REQUIRE(r[matrix_free].curves.size() == 1);
+    }
+    CHECK(r[1].monodromies == 0);
+    CHECK(r[1].krylov_products > 0);
+    const Codim2Point* mf = codim2_of(r[1], k.resonance);
+    const Codim2Point* dense = codim2_of(r[0], k.resonance);
+    REQUIRE(mf != nullptr);
+    REQUIRE(dense != nullptr);
+    measured(std::string("matrix-free - dense ") + k.resonance + " alpha", mf->q - dense->q);
+    measured(std::string("matrix-free - dense ") + k.resonance + " theta", mf->p - dense->p);
+    CHECK(std::abs(mf->p - dense->p) <= 1e-8);
+    CHECK(std::abs(mf->q - dense->q) <= 1e-8);
+    const auto rows = rows_of(r[1], 0);
+    REQUIRE(rows.size() >= 8);
+    int compared = 0;
+    for (std::size_t i = 1; i < rows.size() && compared < 5; i += rows.size() / 6, ++compared) {
+      const CurvePointRecord& p = *rows[i];
+      const FloquetMultipliers mu = multipliers_at(chain, p.p, p.q, p.state);
+      double off = 1e300;  // the pair nearest the curve's multiplier: from the circle, in angle
+      for (const auto& m : mu.values) {
+        if (std::abs(m.imag()) > 1e-6 && std::abs(m - p.multiplier) < 1e-3) {
+          off = std::min(off, std::abs(m - p.multiplier));
+        }
+      }
+      INFO("theta = " << p.p << ", alpha = " << p.q << ", curve's multiplier " << p.multiplier);
+      measured("matrix-free Neimark-Sacker curve: dense monodromy's pair - the curve's multiplier",
+               off);
+      CHECK(off <= 1e-8);
+    }
+  }
 }

@@ -347,6 +347,46 @@ TEST_CASE("Arnoldi reports every multiplier in a band round the unit circle, or 
   CHECK(found.unstable_count() == 10);
 }
 
+TEST_CASE("on an operator its basis spans, Arnoldi reports the whole band at once", "[orbits]") {
+  // Size 40 with a basis of 200: one cycle spans the space and every Ritz value is exact. Twelve
+  // multipliers lie outside the circle (six pairs), another pair on it at e^{±3.1415 i}, and the
+  // rest inside a disc of 0.5: asked for six with a margin of 1e-3, all fourteen of the band must
+  // be reported and the band said to be covered (a basis that spans the operator cannot grow).
+  const Index n = 40;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Matrix D = Matrix::Zero(n, n);
+  std::vector<Complex> band;
+  for (int k = 0; k < 6; ++k) {
+    const double r = 1.05 + 0.1 * k, phi = 0.4 + 0.45 * k;
+    put_pair(D, 2 * k, r, phi);
+    band.push_back(std::polar(r, phi));
+    band.push_back(std::polar(r, -phi));
+  }
+  put_pair(D, 12, 1.0, 3.1415);
+  band.push_back(std::polar(1.0, 3.1415));
+  band.push_back(std::polar(1.0, -3.1415));
+  for (Index i = 14; i + 1 < n; i += 2) put_pair(D, i, 0.5 * std::abs(u(rng)), 3.2 * u(rng));
+  const Matrix A = similar_to(D, rng);
+  ArnoldiOptions options;
+  options.count = 6;
+  options.margin = 1e-3;
+  const FloquetMultipliers found =
+      leading_floquet_multipliers([&A](Matrix& v) { v = A * v; }, n, options);
+  CHECK(found.converged);
+  CHECK(found.band_covered);
+  REQUIRE(found.values.size() >= band.size());
+  double worst = 0.0;
+  for (const Complex& w : band) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const Complex& f : found.values) nearest = std::min(nearest, std::abs(f - w));
+    worst = std::max(worst, nearest);
+  }
+  measured("spanning basis: farthest multiplier of the band from a reported one", worst);
+  CHECK(worst <= 1e-9);
+  CHECK(std::abs(found.values.back()) <= 1.0 - options.margin);
+}
+
 TEST_CASE(
     "restarted Arnoldi finds the leading eigenvalues of a matrix built with them (orbit "
     "multipliers)",

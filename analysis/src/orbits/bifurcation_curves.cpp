@@ -11,6 +11,7 @@
 
 #include "curve_systems.hpp"
 #include "matrix_free_grazing.hpp"
+#include "matrix_free_bordered.hpp"
 #include "pwl/errors.hpp"
 
 namespace pwl::orbits {
@@ -79,7 +80,9 @@ namespace {
 using curves_detail::CurveSystem;
 using curves_detail::GrazingSystem;
 using curves_detail::NeimarkSackerSystem;
+using curves_detail::MatrixFreeCurve;
 using curves_detail::MatrixFreeGrazing;
+using curves_detail::MatrixFreeBordered;
 using curves_detail::PlaneMaps;
 using curves_detail::SingularSystem;
 
@@ -168,13 +171,11 @@ struct Test {
   bool at_largest = true;
 };
 
-// Whether curves of n state components may form the monodromy: the solver dense, or automatic
-// within the dense limit; krylov (`krylov_counts`) or automatic beyond the limit are matrix-free,
-// which only grazing curves can be. Fold, period-doubling and Neimark–Sacker curves are dense
-// whatever the solver where they may be (`krylov_counts` false: krylov within the limit).
-bool dense_allowed(const ShootingOptions& s, Index n, bool krylov_counts = false) {
+// Whether curves of n state components form the monodromy: the solver dense, or automatic within
+// the dense limit; krylov, or automatic beyond the limit, are matrix-free.
+bool dense_allowed(const ShootingOptions& s, Index n) {
   if (s.solver == ShootingSolver::dense) return true;
-  if (krylov_counts && s.solver == ShootingSolver::krylov) return false;
+  if (s.solver == ShootingSolver::krylov) return false;
   return n <= s.dense_state_limit;
 }
 
@@ -244,14 +245,6 @@ class CurvesRunner {
     summary.spring = b.spring;
     summary.at_largest_gap = b.at_largest_gap;
     const Index n = b.state.size();
-    if (summary.type != CurveType::grazing && !dense_allowed(options_.shooting, n)) {
-      note(fmt::format("the {} at {} = {:.10g}: its curve is not followed: its defining system "
-                       "forms the {}x{} monodromy, beyond the dense limit of {} state components "
-                       "(only grazing curves are matrix-free)",
-                       bifurcation_name(b.type), options_.first.name(), b.parameter, n, n,
-                       options_.shooting.dense_state_limit));
-      return;
-    }
     chord_ = options_.corrector == Corrector::chord ||
              (options_.corrector == Corrector::automatic && n > kChordAbove);
     std::unique_ptr<CurveSystem> system;
@@ -271,13 +264,20 @@ class CurvesRunner {
       return;
     }
     system_ = system.get();
-    free_ = dynamic_cast<MatrixFreeGrazing*>(system_);
+    free_ = dynamic_cast<MatrixFreeCurve*>(system_);
     warm_.resize(0, 0);
     type_ = summary.type;
     curve_ = id;
     spring_ = b.spring;
     at_largest_ = b.at_largest_gap;
     tests_ = tests_of(type_);
+    if (free_ != nullptr && options_.codim2 &&
+        (type_ == CurveType::fold || type_ == CurveType::period_doubling)) {
+      note(fmt::format("curve {}: matrix-free, no {} point is looked for (its normal-form "
+                       "coefficient needs the left null vector, products with the transposed "
+                       "monodromy)",
+                       id, type_ == CurveType::fold ? "cusp" : "generalised period-doubling"));
+    }
     unreliable_noted_ = false;
     untrusted_noted_ = false;
     // The first point: the curve's equations with q held at the branch's value.
@@ -317,7 +317,12 @@ class CurvesRunner {
       }
       Walk walk(*this, *first);
       CurvePt last;
-      const WalkEnd end = walk.walk(std::move(start), steps_, options_.max_points, &last);
+      // Matrix-free, the step follows the predictor's error (StepControl's rule for the chord
+      // corrector): inexact Newton's iterations, whose forcing tightens as the residual falls,
+      // say as little about the step as the chord's.
+      StepControl steps = steps_;
+      steps.chord = free_ != nullptr;
+      const WalkEnd end = walk.walk(std::move(start), steps, options_.max_points, &last);
       points += end.points - 1;
       std::string why;
       switch (end.kind) {
@@ -390,6 +395,45 @@ class CurvesRunner {
       return std::make_unique<GrazingSystem>(maps_, k, n, p_scale_, q_scale_, b.spring,
                                              b.at_largest_gap);
     }
+    if (matrix_free(n)) {
+      // The borders: the Ritz vector of the multiplier nearest σ (its phase turned so that its
+      // largest entry is real), or the real and imaginary parts of the pair's; none where Arnoldi
+      // finds no such multiplier within kOnCircle of the unit circle (the branch located the
+      // bifurcation to 1e-8 in its parameter).
+      std::complex<double> target = b.type == BifurcationType::fold ? 1.0 : -1.0;
+      if (b.type == BifurcationType::neimark_sacker) {
+        target = b.multiplier.imag() < 0 ? std::conj(b.multiplier) : b.multiplier;
+      }
+      Eigen::MatrixXcd ritz;
+      const FloquetMultipliers mu = curves_detail::leading_multipliers(
+          maps_, b.state, b.parameter, q0_, k, nullptr, &ritz, MatrixFreeBordered::kOnCircle);
+      Index best = -1;
+      for (Index i = 0; i < static_cast<Index>(mu.values.size()); ++i) {
+        if (best < 0 || std::abs(mu.values[i] - target) < std::abs(mu.values[best] - target)) {
+          best = i;
+        }
+      }
+      if (best < 0 || ritz.cols() <= best ||
+          std::abs(std::abs(mu.values[best]) - 1.0) > MatrixFreeBordered::kOnCircle ||
+          std::abs(mu.values[best] - target) > 0.1) {
+        return nullptr;
+      }
+      const std::complex<double> found = mu.values[best];
+      const Eigen::VectorXcd z = ritz.col(best);
+      Matrix right;
+      if (b.type == BifurcationType::neimark_sacker) {
+        if (std::abs(found.imag()) < 1e-9) return nullptr;
+        right.resize(n, 2);
+        right << z.real(), z.imag();
+        aux = found.real() / std::abs(found);
+      } else {
+        Index largest = 0;
+        z.cwiseAbs().maxCoeff(&largest);
+        right = (z * (std::abs(z(largest)) / z(largest))).real();
+      }
+      return std::make_unique<MatrixFreeBordered>(maps_, k, n, p_scale_, q_scale_,
+                                                  curve_type_of(b.type), right, b.parameter, q0_);
+    }
     Matrix M = Matrix::Identity(n, n);
     maps_.advance(b.state, b.parameter, q0_, k, &M);
     const Eigen::EigenSolver<Matrix> right(M), left(M.transpose());
@@ -422,7 +466,8 @@ class CurvesRunner {
     return std::make_unique<NeimarkSackerSystem>(maps_, k, n, p_scale_, q_scale_, W, V);
   }
 
-  // The curve's codimension-two tests (bifurcation_curves.hpp lists them).
+  // The curve's codimension-two tests (bifurcation_curves.hpp lists them). Matrix-free, not the
+  // cusp's or the generalised period doubling's coefficient: they need the left null vector.
   std::vector<Test> tests_of(CurveType type) const {
     using K = Test::Kind;
     std::vector<Test> tests;
@@ -432,13 +477,15 @@ class CurvesRunner {
       case CurveType::fold:
         tests.push_back({K::det_plus, "fold-flip"});
         tests.push_back({K::second_plus, "resonance-1:1"});
-        tests.push_back({K::cusp, "cusp"});
+        if (free_ == nullptr) tests.push_back({K::cusp, "cusp"});
         grazing_name = "fold-grazing";
         break;
       case CurveType::period_doubling:
         tests.push_back({K::det_minus, "fold-flip"});
         tests.push_back({K::second_minus, "resonance-1:2"});
-        tests.push_back({K::generalised_pd, "generalised-period-doubling"});
+        if (free_ == nullptr) {
+          tests.push_back({K::generalised_pd, "generalised-period-doubling"});
+        }
         grazing_name = "period-doubling-grazing";
         break;
       case CurveType::neimark_sacker:
@@ -478,9 +525,9 @@ class CurvesRunner {
     return *pt.profile;
   }
 
-  // Whether a grazing curve of n state components is followed matrix-free: where the solver is
-  // krylov, or automatic beyond the dense limit.
-  bool matrix_free(Index n) const { return !dense_allowed(options_.shooting, n, true); }
+  // Whether a curve of n state components is followed matrix-free: where the solver is krylov, or
+  // automatic beyond the dense limit.
+  bool matrix_free(Index n) const { return !dense_allowed(options_.shooting, n); }
 
   // The unit tangent at a corrected point, oriented like `previous`.
   Vector tangent_at(const CurvePt& pt, const Vector& previous) {
@@ -496,7 +543,7 @@ class CurvesRunner {
                                    const Vector& tau, const Matrix* start, int corrections,
                                    double polish) {
     if (free_ != nullptr) {
-      std::optional<MatrixFreeGrazing::Corrected> c =
+      std::optional<MatrixFreeCurve::Corrected> c =
           free_->correct(guess, prediction, tau, 2 * corrections, polish);
       if (!c) return std::nullopt;
       CurvePt pt;
@@ -766,7 +813,7 @@ class CurvesRunner {
       const Vector guess = (1 - w) * end_a.u + w * end_b.u;
       CurvePt pt;
       if (free_ != nullptr) {
-        std::optional<MatrixFreeGrazing::Corrected> c = free_->correct(
+        std::optional<MatrixFreeCurve::Corrected> c = free_->correct(
             guess, a.u + s * a.tangent, a.tangent, 2 * (options_.max_corrections + 3), 0.0);
         if (!c) return std::nullopt;
         pt.u = std::move(c->u);
@@ -933,7 +980,7 @@ class CurvesRunner {
   bool chord_ = false;
   // The curve being followed.
   CurveSystem* system_ = nullptr;
-  MatrixFreeGrazing* free_ = nullptr;  // the same system where it is matrix-free
+  MatrixFreeCurve* free_ = nullptr;  // the same system where it is matrix-free
   Eigen::MatrixXcd warm_;              // matrix-free: the last accepted point's Ritz vectors
   CurveType type_ = CurveType::fold;
   int curve_ = 0;
@@ -970,29 +1017,6 @@ CurvesResult follow_bifurcation_curves(const analysis::PointModel& model,
       throw InputError(fmt::format("{} range {}:{}: at {} = {}: {}", options.second.name(),
                                    options.q_from, options.q_to, options.second.name(), q, why));
     }
-  }
-  // Beyond the dense limit only grazing curves can be followed (matrix-free); a run that could
-  // follow none of its starts is refused, one that can follow some notes the others.
-  bool any = true;
-  for (const Bifurcation& start : starts) {
-    const CurveType type = curve_type_of(start.type);
-    if (std::find(options.types.begin(), options.types.end(), type) != options.types.end()) {
-      any = false;
-    }
-  }
-  for (const Bifurcation& start : starts) {
-    const CurveType type = curve_type_of(start.type);
-    if (std::find(options.types.begin(), options.types.end(), type) == options.types.end()) {
-      continue;
-    }
-    any = any || type == CurveType::grazing || dense_allowed(options.shooting, start.state.size());
-  }
-  if (!any) {
-    throw InputError(fmt::format(
-        "the curves of folds, period doublings and Neimark-Sacker points form the {0}x{0} "
-        "monodromy of their defining systems, which are not matrix-free; the dense limit is {1} "
-        "state components (grazing curves are followed matrix-free)",
-        starts.front().state.size(), options.shooting.dense_state_limit));
   }
   CurvesResult result;
   CurvesRunner runner(model, options, observer, result);

@@ -2,9 +2,10 @@
 // The bordered linear systems of matrix-free continuation, solved by GMRES on products of the
 // monodromy. Private to the orbits room.
 //
-//     [ M − I   B ] [ x ]   [ r ]
-//     [  Cᵀ     D ] [ s ] = [ ρ ]
+//     [ M − σI   B ] [ x ]   [ r ]
+//     [  Cᵀ      D ] [ s ] = [ ρ ]
 //
+// (σ = 1 for the orbit's equations; σ = −1 for the condition of a period doubling, M + I singular)
 // with M the monodromy (known only by its products M v, each a tangent integration of the map,
 // replayed from one recorded integration where the integrator records its tangent) and k borders:
 // B (n × k), C (n × k), D (k × k). In one parameter k = 1: b = ∂F/∂p and the border row (cᵀ, d)
@@ -27,7 +28,7 @@
 //
 // Preconditioning. GMRES is right-preconditioned by the inverse of the same bordered matrix with
 // M replaced by the open structure's monodromy M0 (open_structure_preconditioner.hpp: modal 2 x 2
-// blocks), applied by block elimination: with A0 = M0 − I, Z_B = A0⁻¹ B and the k × k Schur
+// blocks), applied by block elimination: with A0 = M0 − σI, Z_B = A0⁻¹ B and the k × k Schur
 // complement S = D − Cᵀ Z_B,
 //
 //     s = S⁻¹ (ρ − Cᵀ A0⁻¹ r),   x = A0⁻¹ r − Z_B s,
@@ -53,15 +54,18 @@ namespace pwl::orbits::detail {
 class BorderedKrylov {
  public:
   // `product(v)` returns M v, followed by the products of the first `implicit_rows` border rows
-  // with v. `open` may be null or unavailable (no preconditioning).
+  // with v. `open` may be null or unavailable (no preconditioning); it inverts the open
+  // structure's counterpart of M − σI (OpenStructurePreconditioner's shift σ; σ = 0 where
+  // `product` gives another operator, such as M² − 2κM + I, and `open` its counterpart).
   BorderedKrylov(std::function<Vector(const Vector&)> product,
                  const OpenStructurePreconditioner* open, Matrix B, Matrix C, Matrix D,
-                 Index implicit_rows = 0)
+                 Index implicit_rows = 0, double shift = 1.0)
       : product_(std::move(product)),
         B_(std::move(B)),
         C_(std::move(C)),
         D_(std::move(D)),
-        implicit_(implicit_rows) {
+        implicit_(implicit_rows),
+        shift_(shift) {
     // The operator's rows: the products stand in for C's first columns.
     C_known_ = C_;
     C_known_.leftCols(implicit_).setZero();
@@ -84,8 +88,9 @@ class BorderedKrylov {
   // product with its inverse, equal to rounding).
   BorderedKrylov(std::function<Vector(const Vector&)> product,
                  const OpenStructurePreconditioner* open, const Vector& b, const Vector& c,
-                 double d)
-      : BorderedKrylov(std::move(product), open, Matrix(b), Matrix(c), Matrix::Constant(1, 1, d)) {}
+                 double d, double shift = 1.0)
+      : BorderedKrylov(std::move(product), open, Matrix(b), Matrix(c), Matrix::Constant(1, 1, d),
+                       0, shift) {}
 
   // Solves to |residual| <= tolerance |[r; ρ]| (2-norms) from zero, at most `restarts` + 1
   // cycles of `dimension` products. Returns what GMRES reached.
@@ -98,7 +103,7 @@ class BorderedKrylov {
       const Vector w = precondition(v);
       const Vector m = product_(w.head(n));
       Vector out(n + k);
-      out.head(n) = m.head(n) - w.head(n) + B_ * w.tail(k);
+      out.head(n) = m.head(n) - shift_ * w.head(n) + B_ * w.tail(k);
       out.tail(k) = C_known_.transpose() * w.head(n) + D_ * w.tail(k);
       if (implicit_ > 0) out.segment(n, implicit_) += m.segment(n, implicit_);
       return out;
@@ -142,6 +147,7 @@ class BorderedKrylov {
   const OpenStructurePreconditioner* open_ = nullptr;
   Matrix B_, C_, C_known_, D_, Z_B_, S_inverse_;
   Index implicit_ = 0;
+  double shift_ = 1.0;
   bool eliminate_ = false;
 };
 

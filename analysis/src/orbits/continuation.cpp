@@ -13,6 +13,7 @@
 
 #include "orbits/bordered_krylov.hpp"
 #include "orbits/multiplier_movement.hpp"
+#include "orbits/newton_krylov.hpp"
 #include "orbits/open_structure_preconditioner.hpp"
 
 namespace pwl::orbits {
@@ -374,57 +375,51 @@ class Continuer {
     if (pt.mu.converged && !pt.mu.band_covered) ++result_.uncovered_bands;
   }
 
-  // Matrix-free corrector: Newton on F(y, p) = 0 with τ · (u − prediction) = 0 from `guess`, each
-  // step the bordered system [M − I, b; τᵀ] δ = −(F, τ · (u − prediction)) solved by GMRES to a
-  // relative residual that tightens as F shrinks (just enough for the next iterate to meet the
-  // tolerance; inexact Newton, S. C. Eisenstat and H. F. Walker, SIAM J. Sci. Comput. 17 (1996)
-  // 16-32). One integration a step (which records the tangent map the step's products replay).
-  // Past the tolerance it polishes as the dense corrector does (CorrectorSettings::polish).
+  // Matrix-free corrector: Newton–Krylov (newton_krylov.hpp: inexact Newton, its forcing and its
+  // polishing) on F(y, p) = 0 with τ · (u − prediction) = 0 from `guess`, each step the bordered
+  // system [M − I, b; τᵀ] δ = −(F, τ · (u − prediction)) solved by GMRES. One integration a step
+  // (which records the tangent map the step's products replay).
   std::optional<Point> correct_matrix_free(const Vector& guess, const Vector& prediction,
                                            const Vector& tau, const Vector& b, int period,
                                            int iterations, bool multipliers, double polish,
                                            const Point* near) {
     const Index N = b.size();
-    Vector u = guess;
-    std::optional<Point> best;
-    double previous = std::numeric_limits<double>::infinity();
-    for (int it = 0;; ++it) {
-      if (!u.allFinite()) break;
+    detail::NewtonKrylovSystem system;
+    system.admissible = [&](const Vector& u) {
       std::string why;
-      if (!model_.accepts(options_.parameter, u(N), &why)) break;
-      Vector F;
+      return model_.accepts(options_.parameter, u(N), &why);
+    };
+    system.scale = [&](const Vector& u) {
+      return std::max(1.0, u.head(N).lpNorm<Eigen::Infinity>());
+    };
+    Vector F;  // at the last u evaluated, which the step starts from
+    system.residual = [&](const Vector& u) -> std::optional<double> {
       try {
         F = residual(u.head(N), u(N), period, nullptr);
       } catch (const Error&) {
-        break;
+        return std::nullopt;
       }
-      if (!F.allFinite()) break;
-      const double scale = std::max(1.0, u.head(N).lpNorm<Eigen::Infinity>());
-      const double res = F.lpNorm<Eigen::Infinity>();
-      const double arc = tau.dot(u - prediction);
-      const double tolerance = options_.shooting.tolerance * scale;
-      if (res <= tolerance && std::abs(arc) <= tolerance) {
-        if (!best || res < best->residual) {
-          best.emplace();
-          best->u = u;
-          best->residual = res;
-          best->iterations = it;
-        }
-        if (polish <= 0 || res <= polish * scale || res > 0.25 * previous) break;
-      } else if (res > 4 * previous) {
-        break;  // diverging
-      }
-      if (it == iterations) break;
-      const double target = polish > 0 ? std::min(tolerance, polish * scale) : tolerance;
-      const double eta = std::clamp(0.5 * target / std::max(res, 1e-300), 1e-10, 1e-2);
+      if (!F.allFinite()) return std::nullopt;
+      return F.lpNorm<Eigen::Infinity>();
+    };
+    system.step = [&](const Vector& u, double arc, double eta) -> std::optional<Vector> {
       Vector dx;
       double ds = 0;
       bordered(u.head(N), u(N), period, b, tau.head(N), tau(N))
           .solve(-F, -arc, dx, ds, eta, options_.shooting.gmres_dimension,
                  options_.shooting.gmres_restarts);
-      u.head(N) += dx;
-      u(N) += ds;
-      previous = res;
+      Vector delta(N + 1);
+      delta << dx, ds;
+      return delta;
+    };
+    const std::optional<detail::NewtonKrylovPoint> c = detail::newton_krylov(
+        system, guess, prediction, tau, iterations, polish, options_.shooting.tolerance);
+    std::optional<Point> best;
+    if (c) {
+      best.emplace();
+      best->u = c->u;
+      best->residual = c->residual;
+      best->iterations = c->iterations;
     }
     if (!best) return std::nullopt;
     if (multipliers) leading_multipliers(*best, period, near != nullptr ? &near->ritz : nullptr);

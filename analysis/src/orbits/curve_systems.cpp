@@ -133,19 +133,25 @@ bool CurveSystem::orbit_rows(const Vector& u, Vector& F, Matrix* jacobian, bool 
     if (jacobian != nullptr) {
       jacobian->topRows(n_).setZero();
       jacobian->topLeftCorner(n_, n_) = M_ - Matrix::Identity(n_, n_);
-      const double dp = kParameterStep * std::max(1.0, std::abs(p));
-      const double dq = kParameterStep * std::max(1.0, std::abs(q));
-      jacobian->col(n_).head(n_) =
-          (maps_.advance(y, p + dp, q, period_) - maps_.advance(y, p - dp, q, period_)) *
-          (p_scale_ / (2 * dp));
-      jacobian->col(n_ + 1).head(n_) =
-          (maps_.advance(y, p, q + dq, period_) - maps_.advance(y, p, q - dq, period_)) *
-          (q_scale_ / (2 * dq));
+      jacobian->block(0, n_, n_, 2) = parameter_columns(u);
     }
   } catch (const Error&) {
     return false;
   }
   return true;
+}
+
+Matrix CurveSystem::parameter_columns(const Vector& u) {
+  const Vector y = u.head(n_);
+  const double p = this->p(u), q = this->q(u);
+  const double dp = kParameterStep * std::max(1.0, std::abs(p));
+  const double dq = kParameterStep * std::max(1.0, std::abs(q));
+  Matrix B(n_, 2);
+  B.col(0) = (maps_.advance(y, p + dp, q, period_) - maps_.advance(y, p - dp, q, period_)) *
+             (p_scale_ / (2 * dp));
+  B.col(1) = (maps_.advance(y, p, q + dq, period_) - maps_.advance(y, p, q - dq, period_)) *
+             (q_scale_ / (2 * dq));
+  return B;
 }
 
 Matrix CurveSystem::monodromy_derivative(const Vector& u, const Vector& v) {
@@ -223,13 +229,17 @@ Vector SingularSystem::left() const {
   return last_.V.col(0) / last_.V.col(0).dot(w);
 }
 
-std::complex<double> SingularSystem::multiplier(const FloquetMultipliers& mu,
-                                                const Vector& /*u*/) const {
+std::complex<double> nearest_multiplier(const FloquetMultipliers& mu, double target) {
   std::complex<double> best{kNaN, 0.0};
   for (const auto& m : mu.values) {
-    if (std::isnan(best.real()) || std::abs(m - sigma_) < std::abs(best - sigma_)) best = m;
+    if (std::isnan(best.real()) || std::abs(m - target) < std::abs(best - target)) best = m;
   }
   return best;
+}
+
+std::complex<double> SingularSystem::multiplier(const FloquetMultipliers& mu,
+                                                const Vector& /*u*/) const {
+  return nearest_multiplier(mu, sigma_);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -331,10 +341,13 @@ void NeimarkSackerSystem::refresh() {
   B_ = orthonormal_columns(last_.V);
 }
 
+std::complex<double> neimark_sacker_multiplier(double kappa) {
+  return {kappa, std::sqrt(std::max(0.0, 1 - kappa * kappa))};
+}
+
 std::complex<double> NeimarkSackerSystem::multiplier(const FloquetMultipliers& /*mu*/,
                                                      const Vector& u) const {
-  const double kappa = this->kappa(u);
-  return {kappa, std::sqrt(std::max(0.0, 1 - kappa * kappa))};
+  return neimark_sacker_multiplier(kappa(u));
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -82,6 +82,8 @@ class CurveSystem : public DefiningSystem {
   // [M − I, ∂F/∂p̂, ∂F/∂q̂, 0]; with `monodromy`, M at u. The monodromy of the same u is kept, so
   // that a second evaluation at the point does not integrate again.
   bool orbit_rows(const Vector& u, Vector& F, Matrix* jacobian, bool monodromy);
+  // [∂F/∂p̂, ∂F/∂q̂] at u by central differences (n × 2).
+  Matrix parameter_columns(const Vector& u);
   // The derivative of the monodromy along the state direction v at u: (M(y + εv) − M(y − εv))/2ε.
   Matrix monodromy_derivative(const Vector& u, const Vector& v);
   // The derivatives along p̂ and q̂ of M·X (X: n × c) at fixed y.
@@ -95,6 +97,11 @@ class CurveSystem : public DefiningSystem {
   Vector M_at_;  // the u whose monodromy M_ is
   Vector F_, F_at_;
 };
+
+// The multiplier of `mu` nearest `target` (NaN where there is none).
+std::complex<double> nearest_multiplier(const FloquetMultipliers& mu, double target);
+// The multiplier e^{iω} of a Neimark–Sacker curve's condition, cos ω = κ.
+std::complex<double> neimark_sacker_multiplier(double kappa);
 
 // Fold (σ = +1, A = M − I) and period doubling (σ = −1, A = M + I): one bordered condition.
 class SingularSystem : public CurveSystem {

@@ -201,6 +201,13 @@ FloquetMultipliers leading_floquet_multipliers(const std::function<void(Matrix&)
     };
     double worst = 0;
     int reported = std::min(wanted, built);
+    // On an invariant subspace every Ritz value is exact: the band is reported whole (the
+    // doubling below is for a basis still growing).
+    if (invariant) {
+      while (reported < built && std::abs(eig.eigenvalues()(order[reported - 1])) > edge) {
+        ++reported;
+      }
+    }
     // A complex pair whole: its second half joins where the count would cut it.
     if (reported < built) {
       const std::complex<double> last = eig.eigenvalues()(order[reported - 1]);

@@ -19,19 +19,8 @@ constexpr double kTangentTolerance = 1e-10;
 MatrixFreeGrazing::MatrixFreeGrazing(PlaneMaps& maps, int period, Index n, double p_scale,
                                      double q_scale, int spring, bool at_largest, double p0,
                                      double q0)
-    : GrazingSystem(maps, period, n, p_scale, q_scale, spring, at_largest) {
-  if (maps.options().shooting.precondition) {
-    StroboscopicMap& map = maps.at(p0, q0);
-    open_.emplace(map.structure(), period * map.forcing_period());
-  }
-}
-
-const detail::OpenStructurePreconditioner* MatrixFreeGrazing::open_at(double p, double q) {
-  if (!open_ || !open_->available()) return nullptr;
-  const double tau = period_ * maps_.at(p, q).forcing_period();
-  if (tau != open_->time()) open_->retime(tau);
-  return &*open_;
-}
+    : GrazingSystem(maps, period, n, p_scale, q_scale, spring, at_largest),
+      open_(maps, period, p0, q0, 1.0) {}
 
 bool MatrixFreeGrazing::residuals(const Vector& u, Linearised& l) {
   if (last_at_.size() == u.size() && last_at_ == u) {
@@ -65,11 +54,7 @@ bool MatrixFreeGrazing::linearise(const Vector& u, Linearised& l) {
   try {
     const double dp = kParameterStep * std::max(1.0, std::abs(p));
     const double dq = kParameterStep * std::max(1.0, std::abs(q));
-    l.B.resize(n_, 2);
-    l.B.col(0) = (maps_.advance(y, p + dp, q, period_) - maps_.advance(y, p - dp, q, period_)) *
-                 (p_scale_ / (2 * dp));
-    l.B.col(1) = (maps_.advance(y, p, q + dq, period_) - maps_.advance(y, p, q - dq, period_)) *
-                 (q_scale_ / (2 * dq));
+    l.B = parameter_columns(u);
     // γ at fixed t (the envelope theorem): the gap at t of the perturbed structures.
     const Vector w = maps_.at(p, q).structure().spring_directions().col(spring_);
     const auto gap_at = [&](double pp, double qq) {
@@ -94,7 +79,7 @@ bool MatrixFreeGrazing::solve(const Vector& u, const Linearised& l, const Vector
   try {
     StroboscopicMap& second = maps_.second_at(p, q);
     StroboscopicMap& first = maps_.at(p, q);
-    const detail::OpenStructurePreconditioner* open = open_at(p, q);
+    const detail::OpenStructurePreconditioner* open = open_.at(p, q);
     const double end = period_ * first.forcing_period();
     const bool whole_first = l.t >= end * (1 - 1e-12);
     const Vector w = first.structure().spring_directions().col(spring_);
@@ -128,41 +113,28 @@ bool MatrixFreeGrazing::solve(const Vector& u, const Linearised& l, const Vector
   return delta.allFinite();
 }
 
-std::optional<MatrixFreeGrazing::Corrected> MatrixFreeGrazing::correct(const Vector& guess,
-                                                                       const Vector& prediction,
-                                                                       const Vector& tau,
-                                                                       int iterations,
-                                                                       double polish) {
-  const double tolerance_rel = maps_.options().shooting.tolerance;
-  Vector u = guess;
-  std::optional<Corrected> best;
-  double previous = std::numeric_limits<double>::infinity();
-  for (int it = 0;; ++it) {
-    if (!admissible(u)) break;
+std::optional<MatrixFreeCurve::Corrected> MatrixFreeGrazing::correct(const Vector& guess,
+                                                                     const Vector& prediction,
+                                                                     const Vector& tau,
+                                                                     int iterations,
+                                                                     double polish) {
+  detail::NewtonKrylovSystem system = newton_system(*this);
+  system.residual = [this](const Vector& u) -> std::optional<double> {
     Linearised l;
-    if (!residuals(u, l)) break;
-    const double scale = this->scale(u);
-    const double res = std::max(l.F.lpNorm<Eigen::Infinity>(), std::abs(l.gamma));
-    const double arc = tau.dot(u - prediction);
-    const double tolerance = tolerance_rel * scale;
-    if (res <= tolerance && std::abs(arc) <= tolerance) {
-      if (!best || res < best->residual) best = Corrected{u, res, it};
-      if (polish <= 0 || res <= polish * scale || res > 0.25 * previous) break;
-    } else if (res > 4 * previous) {
-      break;  // diverging
-    }
-    if (it == iterations) break;
-    if (!linearise(u, l)) break;
-    const double target = polish > 0 ? std::min(tolerance, polish * scale) : tolerance;
-    const double eta = std::clamp(0.5 * target / std::max(res, 1e-300), 1e-10, 1e-2);
+    if (!residuals(u, l)) return std::nullopt;
+    return std::max(l.F.lpNorm<Eigen::Infinity>(), std::abs(l.gamma));
+  };
+  system.step = [&](const Vector& u, double arc, double eta) -> std::optional<Vector> {
+    Linearised l;
+    if (!residuals(u, l) || !linearise(u, l)) return std::nullopt;
     Vector rho(2);
     rho << -l.gamma, -arc;
     Vector delta;
-    if (!solve(u, l, tau, -l.F, rho, delta, eta)) break;
-    u += delta;
-    previous = res;
-  }
-  return best;
+    if (!solve(u, l, tau, -l.F, rho, delta, eta)) return std::nullopt;
+    return delta;
+  };
+  return detail::newton_krylov(system, guess, prediction, tau, iterations, polish,
+                       maps_.options().shooting.tolerance);
 }
 
 Vector MatrixFreeGrazing::tangent(const Vector& u, const Vector& previous) {
@@ -173,25 +145,12 @@ Vector MatrixFreeGrazing::tangent(const Vector& u, const Vector& previous) {
   rho << 0.0, 1.0;
   Vector z;
   if (!solve(u, l, previous, Vector::Zero(n_), rho, z, kTangentTolerance)) return failed;
-  const double norm = z.norm();
-  if (!(norm > 0) || !std::isfinite(norm)) return failed;
-  z /= norm;
-  return z.dot(previous) < 0 ? Vector(-z) : z;
+  return unit_tangent(z, previous);
 }
 
 FloquetMultipliers MatrixFreeGrazing::multipliers(const Vector& u, const Eigen::MatrixXcd* warm,
                                                   Eigen::MatrixXcd* ritz) {
-  const Vector y = u.head(n_);
-  StroboscopicMap& map = maps_.at(p(u), q(u));
-  ArnoldiOptions arnoldi = maps_.options().shooting.arnoldi;
-  arnoldi.block = map.tangent_block();
-  CurvesResult& counts = maps_.result();
-  return leading_floquet_multipliers(
-      [&](Matrix& v) {
-        map.advance(y, period_, v);
-        counts.arnoldi_products += v.cols();
-      },
-      n_, arnoldi, warm, ritz);
+  return leading_multipliers(maps_, u.head(n_), p(u), q(u), period_, warm, ritz);
 }
 
 }  // namespace pwl::orbits::curves_detail

@@ -26,47 +26,30 @@
 // extreme as the orbit's profile locates it: on the exact motion for the exact solver, by
 // interpolation between the steps of a fixed-grid method, as for the dense system). Only an
 // integrator that records its tangent map (the banded switching PIM) replays; for the others each
-// product integrates both arcs. The open structure's inverse is built at the curve's start and
-// retimed to each point's forcing period; where Q changes the linear structure (its damping,
-// masses or stiffnesses) it is that of the start, which only slows GMRES.
+// product integrates both arcs. GMRES is preconditioned by the open structure's inverse
+// (matrix_free_curve.hpp, CurvePreconditioner).
 //
-// The inexact Newton forcing (the relative residual GMRES is asked for tightens as the residual
-// falls) is that of the one-parameter matrix-free continuation: S. C. Eisenstat and H. F. Walker,
-// SIAM J. Sci. Comput. 17 (1996) 16-32. The bordered form of periodic-orbit continuation without
-// the monodromy: K. Lust, D. Roose, A. Spence and A. R. Champneys, SIAM J. Sci. Comput. 19 (1998)
-// 1188-1209. The grazing condition as a defining system: F. Colombo and F. Dercole, SIAM J. Appl.
-// Dyn. Syst. 9(1), 2010.
+// The bordered form of periodic-orbit continuation without the monodromy: K. Lust, D. Roose,
+// A. Spence and A. R. Champneys, SIAM J. Sci. Comput. 19 (1998) 1188-1209. The grazing condition
+// as a defining system: F. Colombo and F. Dercole, SIAM J. Appl. Dyn. Syst. 9(1), 2010. The
+// Newton loop and its forcing: matrix_free_curve.hpp.
 #include <optional>
 
 #include "orbits/curve_systems.hpp"
-#include "orbits/open_structure_preconditioner.hpp"
-#include "pwl/orbits/floquet_multipliers.hpp"
+#include "orbits/matrix_free_curve.hpp"
 
 namespace pwl::orbits::curves_detail {
 
-class MatrixFreeGrazing : public GrazingSystem {
+class MatrixFreeGrazing : public GrazingSystem, public MatrixFreeCurve {
  public:
   MatrixFreeGrazing(PlaneMaps& maps, int period, Index n, double p_scale, double q_scale,
                     int spring, bool at_largest, double p0, double q0);
 
-  struct Corrected {
-    Vector u;
-    double residual = 0.0;  // max(|F|∞, |γ|)
-    int iterations = 0;
-  };
-  // G(u) = 0 with τ · (u − prediction) = 0 from `guess` by Newton–Krylov: at most `iterations`
-  // steps, to the shooting tolerance (relative to the state's size), polished on to `polish` while
-  // each step shrinks the residual fourfold (CorrectorSettings::polish). Empty where it does not
-  // converge, the motion cannot be integrated or u leaves the domain.
   std::optional<Corrected> correct(const Vector& guess, const Vector& prediction,
-                                   const Vector& tau, int iterations, double polish);
-  // The unit tangent of the curve at u, oriented like `previous`: [∂G/∂u; previousᵀ] z = e_last.
-  // Not finite where GMRES fails.
-  Vector tangent(const Vector& u, const Vector& previous);
-  // The leading multipliers of the orbit at u by Arnoldi (ShootingOptions::arnoldi), warm-started
-  // from `warm` (Ritz vectors of a point nearby); its Ritz vectors into `ritz`.
+                                   const Vector& tau, int iterations, double polish) override;
+  Vector tangent(const Vector& u, const Vector& previous) override;
   FloquetMultipliers multipliers(const Vector& u, const Eigen::MatrixXcd* warm,
-                                 Eigen::MatrixXcd* ritz);
+                                 Eigen::MatrixXcd* ritz) override;
 
  private:
   // What a Newton step or a tangent needs at u: the residuals, the extreme's (grid) time and the
@@ -84,9 +67,7 @@ class MatrixFreeGrazing : public GrazingSystem {
   // Solves [J; τᵀ] [δ] = [r; ρ] (J: the system's Jacobian at u, as linearised).
   bool solve(const Vector& u, const Linearised& l, const Vector& tau, const Vector& r,
              const Vector& rho, Vector& delta, double tolerance);
-  const detail::OpenStructurePreconditioner* open_at(double p, double q);
-
-  std::optional<detail::OpenStructurePreconditioner> open_;
+  CurvePreconditioner open_;
   // The residuals of the last u evaluated (the tangent at a corrected point reuses them).
   Linearised last_;
   Vector last_at_;

@@ -47,8 +47,11 @@ namespace pwl::orbits::detail {
 
 class OpenStructurePreconditioner {
  public:
-  // For the map over time `tau` (k forcing periods).
-  OpenStructurePreconditioner(const GapStructure& structure, double tau) {
+  // For the map over time `tau` (k forcing periods), shifted by σ = `shift`: (M0 − σ I)⁻¹. σ = 1
+  // is the orbit's Jacobian M − I; σ = −1 is M + I, the matrix of a period doubling's condition
+  // (singular where a multiplier is −1), whose open-structure inverse is as cheap.
+  OpenStructurePreconditioner(const GapStructure& structure, double tau, double shift = 1.0)
+      : shift_(shift) {
     const Index n = structure.dofs();
     Vector omega2, modal_damping;
     if (auto chain = uniform_chain_modes(structure, modal_damping)) {
@@ -108,6 +111,16 @@ class OpenStructurePreconditioner {
   // Whether the modes are the uniform chain's closed form (no decomposition, no n x n matrix).
   bool closed_form() const { return chain_.has_value(); }
   double time() const { return tau_; }
+  double shift() const { return shift_; }
+
+  // The inverse of M0² − 2κ M0 + I instead (kappa set) or of M0 − σI again (kappa empty): a
+  // Neimark–Sacker curve's condition, singular where a pair of multipliers is e^{±iω} with
+  // cos ω = κ, has the same 2 x 2 modal blocks (O(n) to change).
+  void set_quadratic(std::optional<double> kappa) {
+    if (kappa == kappa_) return;
+    kappa_ = kappa;
+    retime(tau_);
+  }
 
   // The same structure's map over another time (a continuation in the forcing frequency, whose
   // period changes and whose structure does not): the 2 x 2 blocks again, the modes kept (O(n)).
@@ -119,7 +132,9 @@ class OpenStructurePreconditioner {
     for (Index k = 0; k < n; ++k) {
       const double w2 = std::max(0.0, omega2_(k));
       const Eigen::Matrix2d E = exp2x2(w2, modal_damping_(k), tau);
-      const Eigen::Matrix2d J = E - Eigen::Matrix2d::Identity();
+      const Eigen::Matrix2d J =
+          kappa_ ? Eigen::Matrix2d(E * E - 2 * *kappa_ * E + Eigen::Matrix2d::Identity())
+                 : Eigen::Matrix2d(E - shift_ * Eigen::Matrix2d::Identity());
       const double det = J.determinant();
       inverse_[k] = std::abs(det) > 1e-12 ? Eigen::Matrix2d(J.inverse())
                                           : Eigen::Matrix2d(-Eigen::Matrix2d::Identity());
@@ -229,6 +244,8 @@ class OpenStructurePreconditioner {
 
   bool available_ = false;
   double tau_ = 0.0;
+  double shift_ = 1.0;
+  std::optional<double> kappa_;
   Vector omega2_, modal_damping_;
   Matrix phi_;  // the general paths' modal matrix (Φ^T M Φ = I)
   SparseMatrix mass_;

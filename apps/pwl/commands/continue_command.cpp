@@ -480,7 +480,7 @@ void continue_orbit(const ContinueFlags& f) {
     fmt::print("curves' work: {} monodromies, {} other integrations of the map\n",
                curves.monodromies, curves.integrations);
     if (curves.krylov_products > 0 || curves.arnoldi_products > 0) {
-      fmt::print("  matrix-free grazing curves: {} GMRES products, {} Arnoldi products\n",
+      fmt::print("  matrix-free curves: {} GMRES products, {} Arnoldi products\n",
                  curves.krylov_products, curves.arnoldi_products);
       if (curves.unconverged_multipliers > 0 || curves.uncovered_bands > 0) {
         fmt::print("  at {} corrected point(s) Arnoldi stopped short of its tolerance and at {} it "
@@ -631,7 +631,7 @@ ContinuationProblem continuation_problem(const ContinueFlags& f) {
   curves.corrector = c.corrector;
   curves.method = c.method;
   curves.steps_per_period = c.steps_per_period;
-  curves.shooting = c.shooting;  // automatic: grazing curves matrix-free beyond the dense limit
+  curves.shooting = c.shooting;  // automatic: matrix-free beyond the dense limit
   curves.profile_samples = c.profile_samples;
   if (!curves.is_valid(&why)) throw InputError("--curves: " + why);
   problem.curves = curves;
@@ -732,8 +732,9 @@ void add_continue_flags(CLI::App& command, ContinueFlags& flags) {
                      "Neimark-Sacker point and grazing it located in the plane of --parameter\n"
                      "and Q over FROM:TO (any parameter --parameter takes), with their\n"
                      "codimension-two points: OUT/curves.csv, OUT/codim2.csv,\n"
-                     "OUT/bifurcation_curves.png. Beyond the dense limit (200 masses) only\n"
-                     "grazing curves are followed, matrix-free");
+                     "OUT/bifurcation_curves.png. Beyond the dense limit (200 masses)\n"
+                     "the curves are followed matrix-free (no cusp or generalised\n"
+                     "period-doubling point is looked for there)");
   command.add_option("--curve-types", flags.curve_types,
                      "The curves to follow: fold, period-doubling, neimark-sacker, grazing,\n"
                      "comma separated (default: all four)")

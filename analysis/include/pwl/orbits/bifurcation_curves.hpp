@@ -47,15 +47,18 @@
 // P range, closes on itself, reaches its largest number of points, or cannot go on; the reason is
 // kept.
 //
-// Dense or matrix-free. Fold, period-doubling and Neimark–Sacker curves form the monodromy (up to
-// ShootingOptions::dense_state_limit state components, or at any size where the solver is dense;
-// beyond it they are noted and not followed). A grazing curve is followed matrix-free beyond the
-// dense limit (unless the solver is dense), or wherever ShootingOptions::solver is krylov: Newton–Krylov on its doubly bordered system, the gap's
-// gradient known only by its products (matrix_free_grazing.hpp), and the leading multipliers by
-// Arnoldi for the codimension-two tests: det(I ∓ M) over the leading multipliers for the
-// fold–grazing and period-doubling–grazing points, which changes sign where the full determinant
-// does (FloquetMultipliers::shifted_determinant), and the same double-grazing and
-// Neimark–Sacker–grazing tests as dense. Where Arnoldi did not converge or did not reach below
+// Dense or matrix-free. Up to ShootingOptions::dense_state_limit state components (or at any size
+// where the solver is dense) every curve forms the monodromy. Beyond the limit (unless the solver
+// is dense), or wherever ShootingOptions::solver is krylov, every curve is followed matrix-free:
+// Newton–Krylov on the same defining systems, the rows of their conditions known only by products
+// (a gap's gradient: matrix_free_grazing.hpp; the bordered test functions' derivatives:
+// matrix_free_bordered.hpp), and the leading multipliers by Arnoldi for the codimension-two tests:
+// det(I ∓ M) over the leading multipliers (fold–flip, fold– and flip–grazing, fold– and
+// flip–Neimark–Sacker), which changes sign where the full determinant does
+// (FloquetMultipliers::shifted_determinant), a second multiplier at ±1 among them (1:1, 1:2), κ
+// for the resonances on a Neimark–Sacker curve, and the same grazing and Neimark–Sacker–grazing
+// tests as dense. The cusp and the generalised period doubling need the left null vector and are
+// not looked for there (a note says so). Where Arnoldi did not converge or did not reach below
 // every multiplier outside the circle, the multipliers' tests are not evaluated (a note says
 // where), as the branch claims no stability change there.
 #include <complex>
@@ -85,7 +88,7 @@ struct CurvesOptions {
   // (first), 1e-7 (smallest) and 1/25 (largest).
   double initial_step = 0.0, min_step = 0.0, max_step = 0.0;
   int max_points = 1000;  // per direction of each curve
-  // Dense curves only: a matrix-free grazing curve corrects by Newton–Krylov.
+  // Dense curves only: a matrix-free curve corrects by Newton–Krylov.
   Corrector corrector = Corrector::automatic;
   int max_corrections = 7;
   double locate_tolerance = 1e-10;  // of both parameters, for codimension-two points

@@ -1,0 +1,79 @@
+#pragma once
+// What the curves' runner asks of a bifurcation curve followed without the monodromy, and what
+// every such defining system does the same way. Private to the orbits room.
+//
+// A matrix-free curve corrects a point by Newton–Krylov on its bordered system (newton_krylov.hpp),
+// gives the curve's unit tangent from the same system, and the orbit's leading multipliers by
+// Arnoldi; how it poses and solves its bordered system is its own (matrix_free_grazing.hpp: a
+// gap's extreme, whose row is known by its products; matrix_free_singular.hpp: a fold's or a
+// period doubling's condition, whose row is known by a directional derivative). What they share
+// besides is here: the tangent's normalisation, the multipliers and GMRES's preconditioner.
+#include <functional>
+#include <optional>
+
+#include "orbits/curve_systems.hpp"
+#include "orbits/newton_krylov.hpp"
+#include "orbits/open_structure_preconditioner.hpp"
+#include "pwl/orbits/floquet_multipliers.hpp"
+
+namespace pwl::orbits::curves_detail {
+
+class MatrixFreeCurve {
+ public:
+  virtual ~MatrixFreeCurve() = default;
+
+  using Corrected = detail::NewtonKrylovPoint;  // its residual max(|F|∞, |condition|)
+  // G(u) = 0 with τ · (u − prediction) = 0 from `guess` by Newton–Krylov: at most `iterations`
+  // steps, to the shooting tolerance (relative to the state's size), polished on to `polish` while
+  // each step shrinks the residual fourfold (CorrectorSettings::polish). Empty where it does not
+  // converge, the motion cannot be integrated or u leaves the domain.
+  virtual std::optional<Corrected> correct(const Vector& guess, const Vector& prediction,
+                                           const Vector& tau, int iterations, double polish) = 0;
+  // The unit tangent of the curve at u, oriented like `previous`: [∂G/∂u; previousᵀ] z = e_last.
+  // Not finite where GMRES fails.
+  virtual Vector tangent(const Vector& u, const Vector& previous) = 0;
+  // The leading multipliers of the orbit at u by Arnoldi (ShootingOptions::arnoldi), warm-started
+  // from `warm` (Ritz vectors of a point nearby); its Ritz vectors into `ritz`.
+  virtual FloquetMultipliers multipliers(const Vector& u, const Eigen::MatrixXcd* warm,
+                                         Eigen::MatrixXcd* ritz) = 0;
+};
+
+// The Newton–Krylov system of a curve on its domain and its state's scale; its residual and its
+// step are the curve's to set.
+detail::NewtonKrylovSystem newton_system(const CurveSystem& curve);
+
+// M v by the map of (p, q) over `period` forcing periods from y (replayed where the map recorded
+// y), counted as a GMRES product (CurvesResult::krylov_products).
+std::function<Vector(const Vector&)> monodromy_products(PlaneMaps& maps, const Vector& y, double p,
+                                                        double q, int period);
+
+// z normalised and oriented like `previous`; not finite where z is not.
+Vector unit_tangent(const Vector& z, const Vector& previous);
+
+// The leading multipliers of the orbit through y at (p, q) by Arnoldi on its map's products
+// (counted as CurvesResult::arnoldi_products), every one with |μ| > 1 − `margin` among them (at
+// least ArnoldiOptions::margin): a curve whose condition puts a multiplier on the circle asks for
+// a margin, so that its multiplier is reported even where many others lie outside the circle.
+FloquetMultipliers leading_multipliers(PlaneMaps& maps, const Vector& y, double p, double q,
+                                       int period, const Eigen::MatrixXcd* warm,
+                                       Eigen::MatrixXcd* ritz, double margin = 0.0);
+
+// The open structure's (M0 − σI)⁻¹, GMRES's preconditioner on a curve: built from the structure
+// at the curve's start (where ShootingOptions::precondition asks for it) and retimed to each
+// point's forcing period. Where the second parameter changes the linear structure (its damping,
+// masses or stiffnesses) it stays that of the start, which only slows GMRES.
+class CurvePreconditioner {
+ public:
+  CurvePreconditioner(PlaneMaps& maps, int period, double p0, double q0, double shift);
+  // Null where it is not available (non-classical damping, or not asked for). With `kappa`, the
+  // inverse of M0² − 2κM0 + I instead (OpenStructurePreconditioner::set_quadratic).
+  const detail::OpenStructurePreconditioner* at(double p, double q,
+                                                std::optional<double> kappa = {});
+
+ private:
+  PlaneMaps& maps_;
+  int period_;
+  std::optional<detail::OpenStructurePreconditioner> open_;
+};
+
+}  // namespace pwl::orbits::curves_detail
