@@ -531,7 +531,13 @@ TEST_CASE("beyond the dense limit every curve is followed matrix-free", "[orbits
   const CurvesResult r = follow_bifurcation_curves(analysis::PointModel(chain), starts, o);
   REQUIRE(r.curves.size() == 4);
   int types[4] = {0, 0, 0, 0};
-  for (const CurveSummary& c : r.curves) ++types[static_cast<int>(c.type)];
+  for (const CurveSummary& c : r.curves) {
+    ++types[static_cast<int>(c.type)];
+    // Followed: each direction to its largest number of points or out of the range.
+    INFO("curve " << c.curve << ": " << c.ends[0] << "; " << c.ends[1]);
+    CHECK(c.points >= 9);
+    CHECK(rows_of(r, c.curve).size() >= 10);
+  }
   CHECK(types[static_cast<int>(CurveType::period_doubling)] == 2);
   CHECK(types[static_cast<int>(CurveType::grazing)] == 1);
   CHECK(types[static_cast<int>(CurveType::neimark_sacker)] == 1);
@@ -647,7 +653,12 @@ TEST_CASE("matrix-free period-doubling and fold curves are the dense ones, with 
     CHECK(first <= bound);
     CHECK(second <= bound);
   }
-  CHECK(codim2_of(pd[1], "generalised-period-doubling") == nullptr);
+
+  int gpd_noted = 0;
+  for (const std::string& n : pd[1].notes) {
+    gpd_noted += n.find("no generalised period-doubling point is looked for") != std::string::npos;
+  }
+  CHECK(gpd_noted == 1);
 
   // The hardening oscillator's fold curve (one mass: the leading multipliers are both).
   const NondimensionalChain oscillator = pwl::test::hardening_oscillator(1.0);
@@ -693,7 +704,6 @@ TEST_CASE("matrix-free period-doubling and fold curves are the dense ones, with 
     measured("matrix-free fold curve: |mu - 1| of the dense monodromy", to_one);
     CHECK(to_one <= 1e-8);
   }
-  CHECK(codim2_of(fold[1], "cusp") == nullptr);
   int noted = 0;
   for (const std::string& n : fold[1].notes) noted += n.find("no cusp point is looked for") != std::string::npos;
   CHECK(noted == 1);

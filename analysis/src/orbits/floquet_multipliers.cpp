@@ -201,12 +201,14 @@ FloquetMultipliers leading_floquet_multipliers(const std::function<void(Matrix&)
     };
     double worst = 0;
     int reported = std::min(wanted, built);
-    // On an invariant subspace every Ritz value is exact: the band is reported whole (the
-    // doubling below is for a basis still growing).
-    if (invariant) {
+    // A basis that spans the whole space: every Ritz value is an eigenvalue, and the band is
+    // reported whole (the doubling below is for a basis still growing; a breakdown on a smaller
+    // invariant subspace may have missed some).
+    if (invariant && built == size) {
       while (reported < built && std::abs(eig.eigenvalues()(order[reported - 1])) > edge) {
         ++reported;
       }
+      if (reported == built) result.complete = true;
     }
     // A complex pair whole: its second half joins where the count would cut it.
     if (reported < built) {

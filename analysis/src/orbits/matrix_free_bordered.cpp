@@ -187,8 +187,9 @@ std::optional<Vector> MatrixFreeBordered::solve(const Vector& u, const Residuals
         rho(i - 1) = 1.0;
       }
       Vector x, s;
-      K.solve(i == 0 ? r : Vector::Zero(n_), rho, x, s, tolerance, shooting.gmres_dimension,
-              shooting.gmres_restarts);
+      const detail::GmresResult g = K.solve(i == 0 ? r : Vector::Zero(n_), rho, x, s, tolerance,
+                                            shooting.gmres_dimension, shooting.gmres_restarts);
+      if (g.relative_residual > kMissedFactor * tolerance) return std::nullopt;
       Vector z(u.size());
       z << x, s;
       if (!z.allFinite()) return std::nullopt;
@@ -206,12 +207,12 @@ std::optional<Vector> MatrixFreeBordered::solve(const Vector& u, const Residuals
     Ra = entries(*dG);
   }
   Matrix Rc(m, m);
-  if (neimark_sacker()) transverse_.resize(4, m);
+  Matrix transverse(borders() * borders(), m);
   for (Index i = 0; i < m; ++i) {
     const std::optional<Matrix> dG = derivative(u, res, solutions[i + 1]);
     if (!dG) return std::nullopt;
     Rc.col(i) = entries(*dG);
-    if (neimark_sacker()) transverse_.col(i) = Eigen::Map<const Vector>(dG->data(), 4);
+    transverse.col(i) = Eigen::Map<const Vector>(dG->data(), dG->size());
   }
   const Eigen::FullPivLU<Matrix> lu(Rc);
   if (!lu.isInvertible()) return std::nullopt;
@@ -219,6 +220,7 @@ std::optional<Vector> MatrixFreeBordered::solve(const Vector& u, const Residuals
   Vector delta = a;
   for (Index i = 0; i < m; ++i) delta += beta(i) * solutions[i + 1];
   if (!delta.allFinite()) return std::nullopt;
+  transverse_ = std::move(transverse);
   return delta;
 }
 
@@ -290,6 +292,7 @@ void MatrixFreeBordered::refresh() {
   }
   border_ = orthonormal_columns(last_.W);
   last_at_.resize(0);  // G depends on the borders
+  transverse_.resize(0, 0);  // the next choice from the next point's products
 }
 
 std::complex<double> MatrixFreeBordered::multiplier(const FloquetMultipliers& mu,

@@ -49,8 +49,15 @@
 // τ's: E spanning the complement of τ's non-state part (the curve's normal in the parameter plane,
 // or with κ the plane normal to the curve in (p̂, q̂, κ)) makes K regular wherever τ is near the
 // curve's tangent. At a fold M − I is singular along the null vector, which E = (B, 0, 0) covers.
-// A step costs m + 1 bordered GMRES solves and m + 1 products of the rows: 2(m + 1) tangent
-// integrations from perturbed states, k(m + 1) inner solves.
+// Where a curve meets a point at which these arguments fail, K is singular there and ill-conditioned
+// near it: a period-doubling curve's fold–flip point and a Neimark–Sacker curve's fold–NS point
+// (M − I singular too, along a null vector E does not see), a fold curve's cusp (τ along the null
+// vector, as E is). The step's two parts then grow and cancel; the tests pass through a fold–flip
+// point (located within 6e-13 of the dense curve's) and a cusp on small systems, but a curve
+// through such a point of a long chain may lose accuracy or stop there. A step costs m + 1 bordered
+// GMRES solves (each failing where GMRES ends far above its tolerance), the parameter columns'
+// four integrations, and m + 1 products of the rows: 2(m + 1) tangent integrations from perturbed
+// states, k(m + 1) inner solves.
 //
 // The leading multipliers come from Arnoldi (matrix_free_curve.hpp), with every multiplier within
 // kOnCircle of the unit circle among them: the curve's own (±1 or the pair) is reported even where
@@ -121,7 +128,9 @@ class MatrixFreeBordered : public CurveSystem, public MatrixFreeCurve {
   std::optional<CurvePreconditioner> condition_;  // (M0 + I)⁻¹ or (M0² − 2κM0 + I)⁻¹
   Residuals last_;
   Vector last_at_;
-  Matrix transverse_;  // Neimark–Sacker: the four entries' products along the last c_i (4 × 2)
+  // G's entries' products along the c_i of the last step that succeeded (k² × m; Neimark–Sacker:
+  // 4 × 2), emptied at each accepted point.
+  Matrix transverse_;
 };
 
 }  // namespace pwl::orbits::curves_detail

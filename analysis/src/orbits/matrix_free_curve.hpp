@@ -5,9 +5,10 @@
 // A matrix-free curve corrects a point by Newton–Krylov on its bordered system (newton_krylov.hpp),
 // gives the curve's unit tangent from the same system, and the orbit's leading multipliers by
 // Arnoldi; how it poses and solves its bordered system is its own (matrix_free_grazing.hpp: a
-// gap's extreme, whose row is known by its products; matrix_free_singular.hpp: a fold's or a
-// period doubling's condition, whose row is known by a directional derivative). What they share
-// besides is here: the tangent's normalisation, the multipliers and GMRES's preconditioner.
+// gap's extreme, whose row is known by its products; matrix_free_bordered.hpp: a fold's, a period
+// doubling's or a Neimark–Sacker point's condition, whose rows are known by directional
+// derivatives). What they share besides is here: the tangent's normalisation, the multipliers
+// and GMRES's preconditioner.
 #include <functional>
 #include <optional>
 

@@ -32,7 +32,7 @@
 // The bordered form of periodic-orbit continuation without the monodromy: K. Lust, D. Roose,
 // A. Spence and A. R. Champneys, SIAM J. Sci. Comput. 19 (1998) 1188-1209. The grazing condition
 // as a defining system: F. Colombo and F. Dercole, SIAM J. Appl. Dyn. Syst. 9(1), 2010. The
-// Newton loop and its forcing: matrix_free_curve.hpp.
+// Newton loop and its forcing: newton_krylov.hpp.
 #include <optional>
 
 #include "orbits/curve_systems.hpp"

@@ -733,8 +733,8 @@ void add_continue_flags(CLI::App& command, ContinueFlags& flags) {
                      "and Q over FROM:TO (any parameter --parameter takes), with their\n"
                      "codimension-two points: OUT/curves.csv, OUT/codim2.csv,\n"
                      "OUT/bifurcation_curves.png. Beyond the dense limit (200 masses)\n"
-                     "the curves are followed matrix-free (no cusp or generalised\n"
-                     "period-doubling point is looked for there)");
+                     "the curves are followed matrix-free, by Newton-Krylov (no cusp or\n"
+                     "generalised period-doubling point is looked for there)");
   command.add_option("--curve-types", flags.curve_types,
                      "The curves to follow: fold, period-doubling, neimark-sacker, grazing,\n"
                      "comma separated (default: all four)")

@@ -94,7 +94,8 @@ struct ArnoldiOptions {
 // its argument, size x p, by M times them) by thick-restarted Arnoldi. `complete` is false unless count
 // reaches `size`. A complex pair is reported whole: the count grows by one where it would cut a
 // pair in two, and doubles while the smallest reported lies in the band of ArnoldiOptions::margin.
-// Throws InputError for invalid options.
+// Where the basis spans the whole space (size <= the Krylov dimension) every multiplier of the
+// band is reported at once, since each is then exact. Throws InputError for invalid options.
 //
 // Warm start (continuation, where the orbit moves little from one point to the next): `warm`, the
 // Ritz vectors of a nearby operator (size x k, complex), starts the iteration from their sum
