@@ -23,14 +23,13 @@ constexpr double kTestTolerance = 1e-12;
 constexpr double kRowTolerance = 1e-10;
 // A solve that ends more than this factor above the relative residual it was asked for fails.
 constexpr double kMissedFactor = 100.0;
-// GMRES's relative residual for a tangent (as the one-parameter continuation asks).
-constexpr double kTangentTolerance = 1e-10;
 }  // namespace
 
 MatrixFreeBordered::MatrixFreeBordered(PlaneMaps& maps, int period, Index n, double p_scale,
                                        double q_scale, CurveType type, const Matrix& right,
                                        double p0, double q0)
     : CurveSystem(maps, period, n, p_scale, q_scale),
+      MatrixFreeCurve(maps.options().shooting.tolerance),
       type_(type),
       sigma_(type == CurveType::fold ? 1.0 : type == CurveType::period_doubling ? -1.0 : 0.0),
       border_(orthonormal_columns(right)),
@@ -224,35 +223,21 @@ std::optional<Vector> MatrixFreeBordered::solve(const Vector& u, const Residuals
   return delta;
 }
 
-std::optional<MatrixFreeCurve::Corrected> MatrixFreeBordered::correct(const Vector& guess,
-                                                                      const Vector& prediction,
-                                                                      const Vector& tau,
-                                                                      int iterations,
-                                                                      double polish) {
-  detail::NewtonKrylovSystem system = newton_system(*this);
-  system.residual = [this](const Vector& u) -> std::optional<double> {
-    Residuals r;
-    if (!residuals(u, r)) return std::nullopt;
-    return std::max(r.F.lpNorm<Eigen::Infinity>(), entries(r.G).lpNorm<Eigen::Infinity>());
-  };
-  system.step = [&](const Vector& u, double arc, double eta) -> std::optional<Vector> {
-    Residuals r;
-    if (!residuals(u, r)) return std::nullopt;
-    return solve(u, r, tau, -r.F, -entries(r.G), -arc, eta);
-  };
-  return detail::newton_krylov(system, guess, prediction, tau, iterations, polish,
-                               maps_.options().shooting.tolerance);
+std::optional<double> MatrixFreeBordered::residual_norm(const Vector& u) {
+  Residuals r;
+  if (!residuals(u, r)) return std::nullopt;
+  return std::max(r.F.lpNorm<Eigen::Infinity>(), entries(r.G).lpNorm<Eigen::Infinity>());
 }
 
-Vector MatrixFreeBordered::tangent(const Vector& u, const Vector& previous) {
+std::optional<Vector> MatrixFreeBordered::bordered_solve(const Vector& u, const Vector& tau,
+                                                         std::optional<double> arc,
+                                                         double tolerance) {
   Residuals r;
-  std::optional<Vector> z;
-  if (residuals(u, r)) {
-    z = solve(u, r, previous, Vector::Zero(n_), Vector::Zero(conditions()), 1.0,
-              kTangentTolerance);
+  if (!residuals(u, r)) return std::nullopt;
+  if (!arc) {
+    return solve(u, r, tau, Vector::Zero(n_), Vector::Zero(conditions()), 1.0, tolerance);
   }
-  if (!z) return Vector::Constant(u.size(), std::numeric_limits<double>::quiet_NaN());
-  return unit_tangent(*z, previous);
+  return solve(u, r, tau, -r.F, -entries(r.G), -*arc, tolerance);
 }
 
 FloquetMultipliers MatrixFreeBordered::multipliers(const Vector& u, const Eigen::MatrixXcd* warm,

@@ -89,11 +89,14 @@ class MatrixFreeBordered : public CurveSystem, public MatrixFreeCurve {
   void refresh() override;
   std::complex<double> multiplier(const FloquetMultipliers& mu, const Vector& u) const override;
 
-  std::optional<Corrected> correct(const Vector& guess, const Vector& prediction,
-                                   const Vector& tau, int iterations, double polish) override;
-  Vector tangent(const Vector& u, const Vector& previous) override;
   FloquetMultipliers multipliers(const Vector& u, const Eigen::MatrixXcd* warm,
                                  Eigen::MatrixXcd* ritz) override;
+
+ protected:
+  const CurveSystem& curve() const override { return *this; }
+  std::optional<double> residual_norm(const Vector& u) override;
+  std::optional<Vector> bordered_solve(const Vector& u, const Vector& tau,
+                                       std::optional<double> arc, double tolerance) override;
 
  private:
   // The residuals at u and the inner solution there.

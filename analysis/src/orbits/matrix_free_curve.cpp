@@ -6,11 +6,24 @@
 
 namespace pwl::orbits::curves_detail {
 
-detail::NewtonKrylovSystem newton_system(const CurveSystem& curve) {
-  detail::NewtonKrylovSystem system;
-  system.admissible = [&curve](const Vector& u) { return curve.admissible(u); };
-  system.scale = [&curve](const Vector& u) { return curve.scale(u); };
-  return system;
+namespace {
+// GMRES's relative residual for a tangent (as the one-parameter continuation asks).
+constexpr double kTangentTolerance = 1e-10;
+}  // namespace
+
+std::optional<MatrixFreeCurve::Corrected> MatrixFreeCurve::correct(const Vector& guess,
+                                                                   const Vector& prediction,
+                                                                   const Vector& tau,
+                                                                   int iterations, double polish) {
+  const CurveSystem& system = curve();
+  detail::NewtonKrylovSystem newton;
+  newton.admissible = [&system](const Vector& u) { return system.admissible(u); };
+  newton.scale = [&system](const Vector& u) { return system.scale(u); };
+  newton.residual = [this](const Vector& u) { return residual_norm(u); };
+  newton.step = [&](const Vector& u, double arc, double eta) {
+    return bordered_solve(u, tau, arc, eta);
+  };
+  return detail::newton_krylov(newton, guess, prediction, tau, iterations, polish, tolerance_);
 }
 
 std::function<Vector(const Vector&)> monodromy_products(PlaneMaps& maps, const Vector& y, double p,
@@ -25,12 +38,13 @@ std::function<Vector(const Vector&)> monodromy_products(PlaneMaps& maps, const V
   };
 }
 
-Vector unit_tangent(const Vector& z, const Vector& previous) {
-  const double norm = z.norm();
+Vector MatrixFreeCurve::tangent(const Vector& u, const Vector& previous) {
+  const std::optional<Vector> z = bordered_solve(u, previous, std::nullopt, kTangentTolerance);
+  const double norm = z ? z->norm() : 0.0;
   if (!(norm > 0) || !std::isfinite(norm)) {
-    return Vector::Constant(z.size(), std::numeric_limits<double>::quiet_NaN());
+    return Vector::Constant(u.size(), std::numeric_limits<double>::quiet_NaN());
   }
-  const Vector t = z / norm;
+  const Vector t = *z / norm;
   return t.dot(previous) < 0 ? Vector(-t) : t;
 }
 

@@ -7,8 +7,9 @@
 // Arnoldi; how it poses and solves its bordered system is its own (matrix_free_grazing.hpp: a
 // gap's extreme, whose row is known by its products; matrix_free_bordered.hpp: a fold's, a period
 // doubling's or a Neimark–Sacker point's condition, whose rows are known by directional
-// derivatives). What they share besides is here: the tangent's normalisation, the multipliers
-// and GMRES's preconditioner.
+// derivatives): it gives its residual and its bordered solve, and the corrector and the tangent
+// here are built on them. What they share besides is here too: the multipliers and GMRES's
+// preconditioner.
 #include <functional>
 #include <optional>
 
@@ -21,35 +22,45 @@ namespace pwl::orbits::curves_detail {
 
 class MatrixFreeCurve {
  public:
+  // `tolerance`: the orbits' (ShootingOptions::tolerance), relative to the state's size.
+  explicit MatrixFreeCurve(double tolerance) : tolerance_(tolerance) {}
   virtual ~MatrixFreeCurve() = default;
 
   using Corrected = detail::NewtonKrylovPoint;  // its residual max(|F|∞, |condition|)
   // G(u) = 0 with τ · (u − prediction) = 0 from `guess` by Newton–Krylov: at most `iterations`
   // steps, to the shooting tolerance (relative to the state's size), polished on to `polish` while
   // each step shrinks the residual fourfold (CorrectorSettings::polish). Empty where it does not
-  // converge, the motion cannot be integrated or u leaves the domain.
-  virtual std::optional<Corrected> correct(const Vector& guess, const Vector& prediction,
-                                           const Vector& tau, int iterations, double polish) = 0;
+  // converge, the motion cannot be integrated or u leaves the domain (newton_krylov.hpp, on the
+  // curve's residual_norm and bordered_solve).
+  std::optional<Corrected> correct(const Vector& guess, const Vector& prediction,
+                                   const Vector& tau, int iterations, double polish);
   // The unit tangent of the curve at u, oriented like `previous`: [∂G/∂u; previousᵀ] z = e_last.
   // Not finite where GMRES fails.
-  virtual Vector tangent(const Vector& u, const Vector& previous) = 0;
+  Vector tangent(const Vector& u, const Vector& previous);
   // The leading multipliers of the orbit at u by Arnoldi (ShootingOptions::arnoldi), warm-started
   // from `warm` (Ritz vectors of a point nearby); its Ritz vectors into `ritz`.
   virtual FloquetMultipliers multipliers(const Vector& u, const Eigen::MatrixXcd* warm,
                                          Eigen::MatrixXcd* ritz) = 0;
-};
 
-// The Newton–Krylov system of a curve on its domain and its state's scale; its residual and its
-// step are the curve's to set.
-detail::NewtonKrylovSystem newton_system(const CurveSystem& curve);
+ protected:
+  // The curve as a defining system: its domain and its state's scale.
+  virtual const CurveSystem& curve() const = 0;
+  // max(|F|∞, |the conditions|) at u; empty where it cannot be evaluated.
+  virtual std::optional<double> residual_norm(const Vector& u) = 0;
+  // [∂G/∂u; τᵀ] δ = [r; ρ] at u by GMRES to the relative residual `tolerance`: a Newton step
+  // (r = −G(u), ρ = −arc) or, without `arc`, the tangent's system (r = 0, ρ = e_last). Empty where
+  // it fails.
+  virtual std::optional<Vector> bordered_solve(const Vector& u, const Vector& tau,
+                                               std::optional<double> arc, double tolerance) = 0;
+
+ private:
+  double tolerance_;
+};
 
 // M v by the map of (p, q) over `period` forcing periods from y (replayed where the map recorded
 // y), counted as a GMRES product (CurvesResult::krylov_products).
 std::function<Vector(const Vector&)> monodromy_products(PlaneMaps& maps, const Vector& y, double p,
                                                         double q, int period);
-
-// z normalised and oriented like `previous`; not finite where z is not.
-Vector unit_tangent(const Vector& z, const Vector& previous);
 
 // The leading multipliers of the orbit through y at (p, q) by Arnoldi on its map's products
 // (counted as CurvesResult::arnoldi_products), every one with |μ| > 1 − `margin` among them (at

@@ -12,14 +12,13 @@ namespace pwl::orbits::curves_detail {
 namespace {
 // The relative step of the central differences in a parameter (as the dense system takes them).
 constexpr double kParameterStep = 1e-6;
-// GMRES's relative residual for a tangent (as the one-parameter continuation asks).
-constexpr double kTangentTolerance = 1e-10;
 }  // namespace
 
 MatrixFreeGrazing::MatrixFreeGrazing(PlaneMaps& maps, int period, Index n, double p_scale,
                                      double q_scale, int spring, bool at_largest, double p0,
                                      double q0)
     : GrazingSystem(maps, period, n, p_scale, q_scale, spring, at_largest),
+      MatrixFreeCurve(maps.options().shooting.tolerance),
       open_(maps, period, p0, q0, 1.0) {}
 
 bool MatrixFreeGrazing::residuals(const Vector& u, Linearised& l) {
@@ -113,39 +112,28 @@ bool MatrixFreeGrazing::solve(const Vector& u, const Linearised& l, const Vector
   return delta.allFinite();
 }
 
-std::optional<MatrixFreeCurve::Corrected> MatrixFreeGrazing::correct(const Vector& guess,
-                                                                     const Vector& prediction,
-                                                                     const Vector& tau,
-                                                                     int iterations,
-                                                                     double polish) {
-  detail::NewtonKrylovSystem system = newton_system(*this);
-  system.residual = [this](const Vector& u) -> std::optional<double> {
-    Linearised l;
-    if (!residuals(u, l)) return std::nullopt;
-    return std::max(l.F.lpNorm<Eigen::Infinity>(), std::abs(l.gamma));
-  };
-  system.step = [&](const Vector& u, double arc, double eta) -> std::optional<Vector> {
-    Linearised l;
-    if (!residuals(u, l) || !linearise(u, l)) return std::nullopt;
-    Vector rho(2);
-    rho << -l.gamma, -arc;
-    Vector delta;
-    if (!solve(u, l, tau, -l.F, rho, delta, eta)) return std::nullopt;
-    return delta;
-  };
-  return detail::newton_krylov(system, guess, prediction, tau, iterations, polish,
-                       maps_.options().shooting.tolerance);
+std::optional<double> MatrixFreeGrazing::residual_norm(const Vector& u) {
+  Linearised l;
+  if (!residuals(u, l)) return std::nullopt;
+  return std::max(l.F.lpNorm<Eigen::Infinity>(), std::abs(l.gamma));
 }
 
-Vector MatrixFreeGrazing::tangent(const Vector& u, const Vector& previous) {
-  const Vector failed = Vector::Constant(u.size(), std::numeric_limits<double>::quiet_NaN());
+std::optional<Vector> MatrixFreeGrazing::bordered_solve(const Vector& u, const Vector& tau,
+                                                        std::optional<double> arc,
+                                                        double tolerance) {
   Linearised l;
-  if (!residuals(u, l) || !linearise(u, l)) return failed;
+  if (!residuals(u, l) || !linearise(u, l)) return std::nullopt;
   Vector rho(2);
-  rho << 0.0, 1.0;
-  Vector z;
-  if (!solve(u, l, previous, Vector::Zero(n_), rho, z, kTangentTolerance)) return failed;
-  return unit_tangent(z, previous);
+  if (arc) {
+    rho << -l.gamma, -*arc;
+  } else {
+    rho << 0.0, 1.0;
+  }
+  Vector delta;
+  if (!solve(u, l, tau, arc ? Vector(-l.F) : Vector(Vector::Zero(n_)), rho, delta, tolerance)) {
+    return std::nullopt;
+  }
+  return delta;
 }
 
 FloquetMultipliers MatrixFreeGrazing::multipliers(const Vector& u, const Eigen::MatrixXcd* warm,

@@ -45,11 +45,14 @@ class MatrixFreeGrazing : public GrazingSystem, public MatrixFreeCurve {
   MatrixFreeGrazing(PlaneMaps& maps, int period, Index n, double p_scale, double q_scale,
                     int spring, bool at_largest, double p0, double q0);
 
-  std::optional<Corrected> correct(const Vector& guess, const Vector& prediction,
-                                   const Vector& tau, int iterations, double polish) override;
-  Vector tangent(const Vector& u, const Vector& previous) override;
   FloquetMultipliers multipliers(const Vector& u, const Eigen::MatrixXcd* warm,
                                  Eigen::MatrixXcd* ritz) override;
+
+ protected:
+  const CurveSystem& curve() const override { return *this; }
+  std::optional<double> residual_norm(const Vector& u) override;
+  std::optional<Vector> bordered_solve(const Vector& u, const Vector& tau,
+                                       std::optional<double> arc, double tolerance) override;
 
  private:
   // What a Newton step or a tangent needs at u: the residuals, the extreme's (grid) time and the
