@@ -65,6 +65,59 @@ TEST_CASE("matrix-free continuation locates figure 4a's period doubling and swit
   CHECK(period_two >= 5);
 }
 
+TEST_CASE("with GMRES recycling the matrix-free branch is the same branch", "[orbits]") {
+  // Plain GMRES (60 vectors, nothing recycled) against GCRO-DR cycles of 4 vectors of which 2 are
+  // recycled from one cycle to the next (gmres.hpp): the 11 unknowns of each bordered system need
+  // restarts there (cycles of 8 did not: the solves are that short). The branch, its period doubling and its stability must not change beyond the
+  // corrector's tolerance.
+  const NondimensionalChain chain = pwl::test::paper_case_at("4a", 1.1);
+  const MethodSettings method{Method::exact};
+  const Vector start = figure_4a_orbit(chain, method);
+  ContinuationOptions plain_options = figure_4a_options(method);
+  plain_options.shooting.gmres_recycled = 0;
+  ContinuationOptions recycled_options = plain_options;
+  recycled_options.shooting.gmres_dimension = 4;
+  recycled_options.shooting.gmres_recycled = 2;
+  recycled_options.shooting.gmres_restarts = 100;
+  const ContinuationResult plain = follow(chain, start, plain_options, ShootingSolver::krylov);
+  const ContinuationResult recycled =
+      follow(chain, start, recycled_options, ShootingSolver::krylov);
+  // The cycles of 8 took another path (restarts, recycled vectors) to the same branch.
+  INFO("GMRES products: plain " << plain.krylov_products << ", recycled "
+                                << recycled.krylov_products);
+  CHECK(plain.krylov_products != recycled.krylov_products);
+  const Bifurcation* a = pwl::test::first_doubling(plain);
+  const Bifurcation* b = pwl::test::first_doubling(recycled);
+  REQUIRE(a != nullptr);
+  REQUIRE(b != nullptr);
+  measured("figure 4a: period doubling with recycling against without",
+           std::abs(a->parameter - b->parameter));
+  CHECK(std::abs(a->parameter - b->parameter) <= 1e-8);
+  CHECK(plain.bifurcations.size() == recycled.bifurcations.size());
+  // Both branches' points carry one stability on each side of the doubling, the same in both, and
+  // it changes there.
+  int kinds[2][2] = {{0, 0}, {0, 0}};  // [run][side]: points stable; −1 unstable; 2 mixed
+  const ContinuationResult* runs[2] = {&plain, &recycled};
+  for (int run = 0; run < 2; ++run) {
+    int seen[2][2] = {{0, 0}, {0, 0}};  // [side][stable]
+    for (const BranchPoint& pt : runs[run]->points) {
+      if (pt.branch != 0 || std::abs(pt.parameter - a->parameter) < 1e-6) continue;
+      ++seen[pt.parameter > a->parameter][pt.orbit.stable() ? 1 : 0];
+    }
+    for (int side = 0; side < 2; ++side) {
+      INFO("run " << run << ", side " << side << ": " << seen[side][1] << " stable, "
+                  << seen[side][0] << " unstable");
+      CHECK(seen[side][0] + seen[side][1] >= 3);
+      kinds[run][side] = seen[side][0] > 0 && seen[side][1] > 0 ? 2 : seen[side][1] > 0 ? 1 : -1;
+    }
+  }
+  CHECK(kinds[0][0] == kinds[1][0]);
+  CHECK(kinds[0][1] == kinds[1][1]);
+  CHECK(kinds[0][0] != 2);
+  CHECK(kinds[0][1] != 2);
+  CHECK(kinds[0][0] == -kinds[0][1]);
+}
+
 TEST_CASE("matrix-free continuation claims no stability change from multipliers that did not converge",
           "[orbits]") {
   // The same branch with Arnoldi starved (a basis of 3 for 10 state components, no restart): its

@@ -93,9 +93,11 @@ class BorderedKrylov {
                        0, shift) {}
 
   // Solves to |residual| <= tolerance |[r; ρ]| (2-norms) from zero, at most `restarts` + 1
-  // cycles of `dimension` products. Returns what GMRES reached.
+  // cycles of `dimension` products, recycling through `recycled` where it is given (gmres.hpp:
+  // the space lives in GMRES's preconditioned variable, and the caller says when the operator
+  // changed). Returns what GMRES reached.
   GmresResult solve(const Vector& r, const Vector& rho, Vector& x, Vector& s, double tolerance,
-                    int dimension, int restarts) const {
+                    int dimension, int restarts, RecycledSubspace* recycled = nullptr) const {
     const Index n = r.size(), k = borders();
     Vector rhs(n + k);
     rhs << r, rho;
@@ -109,7 +111,7 @@ class BorderedKrylov {
       return out;
     };
     Vector u;
-    const GmresResult g = gmres(apply, rhs, u, tolerance, dimension, restarts);
+    const GmresResult g = gmres(apply, rhs, u, tolerance, dimension, restarts, recycled);
     const Vector z = precondition(u);
     x = z.head(n);
     s = z.tail(k);
@@ -117,10 +119,10 @@ class BorderedKrylov {
   }
   // One border.
   GmresResult solve(const Vector& r, double rho, Vector& x, double& s, double tolerance,
-                    int dimension, int restarts) const {
+                    int dimension, int restarts, RecycledSubspace* recycled = nullptr) const {
     Vector sv;
     const GmresResult g =
-        solve(r, Vector::Constant(1, rho), x, sv, tolerance, dimension, restarts);
+        solve(r, Vector::Constant(1, rho), x, sv, tolerance, dimension, restarts, recycled);
     s = sv(0);
     return g;
   }

@@ -163,7 +163,11 @@ class Continuer {
  public:
   Continuer(const analysis::PointModel& model, const ContinuationOptions& options,
             ContinuationObserver* observer, ContinuationResult& result)
-      : model_(model), options_(options), observer_(observer), result_(result) {
+      : model_(model),
+        recycled_(options.shooting.gmres_recycled),
+        options_(options),
+        observer_(observer),
+        result_(result) {
     const double range = std::abs(options.end - options.start);
     initial_step_ = options.initial_step > 0 ? options.initial_step : range / 100;
     min_step_ = options.min_step > 0 ? options.min_step : 1e-7 * range;
@@ -212,7 +216,7 @@ class Continuer {
       double s = 0;
       bordered(first.y(), first.p(), period, first.b, Vector::Zero(N), 1.0)
           .solve(Vector::Zero(N), 1.0, x, s, kTangentTolerance, options_.shooting.gmres_dimension,
-                 options_.shooting.gmres_restarts);
+                 options_.shooting.gmres_restarts, &recycled_);
       z << x, s;
     } else {
       first.M = orbit.monodromy;
@@ -324,7 +328,7 @@ class Continuer {
     double s = 0;
     bordered(pt.y(), pt.p(), period, pt.b, previous.head(N), previous(N))
         .solve(Vector::Zero(N), 1.0, x, s, kTangentTolerance, options_.shooting.gmres_dimension,
-               options_.shooting.gmres_restarts);
+               options_.shooting.gmres_restarts, &recycled_);
     Vector z(N + 1);
     z << x, s;
     z /= z.norm();
@@ -346,6 +350,7 @@ class Continuer {
                                   const Vector& c, double d) {
     StroboscopicMap& map = map_at(p);
     const detail::OpenStructurePreconditioner* open = open_at(p, period);
+    recycled_.operator_changed();
     return detail::BorderedKrylov(
         [this, &map, y, period](const Vector& v) {
           Matrix t = v;
@@ -407,7 +412,7 @@ class Continuer {
       double ds = 0;
       bordered(u.head(N), u(N), period, b, tau.head(N), tau(N))
           .solve(-F, -arc, dx, ds, eta, options_.shooting.gmres_dimension,
-                 options_.shooting.gmres_restarts);
+                 options_.shooting.gmres_restarts, &recycled_);
       Vector delta(N + 1);
       delta << dx, ds;
       return delta;
@@ -1132,6 +1137,8 @@ class Continuer {
   bool chord_ = true;  // the corrector: chord steps, or Newton
   bool matrix_free_ = false;  // beyond the dense limit: Newton-Krylov and Arnoldi
   std::optional<detail::OpenStructurePreconditioner> open_;  // matrix-free: GMRES's preconditioner
+  // Matrix-free: GMRES's recycled subspace (gmres.hpp), from one bordered system to the next.
+  detail::RecycledSubspace recycled_;
   const ContinuationOptions& options_;
   ContinuationObserver* observer_;
   ContinuationResult& result_;

@@ -33,7 +33,9 @@ MatrixFreeBordered::MatrixFreeBordered(PlaneMaps& maps, int period, Index n, dou
       type_(type),
       sigma_(type == CurveType::fold ? 1.0 : type == CurveType::period_doubling ? -1.0 : 0.0),
       border_(orthonormal_columns(right)),
-      open_(maps, period, p0, q0, 1.0) {
+      open_(maps, period, p0, q0, 1.0),
+      inner_space_(maps.options().shooting.gmres_recycled),
+      outer_space_(maps.options().shooting.gmres_recycled) {
   if (type != CurveType::fold) condition_.emplace(maps, period, p0, q0, sigma_);  // NS: set by κ
 }
 
@@ -66,8 +68,12 @@ bool MatrixFreeBordered::inner(const Vector& u, const Vector& x, const Vector& r
   }
   const detail::BorderedKrylov system(product, open, border_, border_,
                                       Matrix::Zero(borders(), borders()), 0, shift);
-  const detail::GmresResult g =
-      system.solve(x, rho, w, s, tolerance, shooting.gmres_dimension, shooting.gmres_restarts);
+  if (inner_at_.size() != u.size() || inner_at_ != u) {
+    inner_space_.operator_changed();
+    inner_at_ = u;
+  }
+  const detail::GmresResult g = system.solve(x, rho, w, s, tolerance, shooting.gmres_dimension,
+                                             shooting.gmres_restarts, &inner_space_);
   return g.relative_residual <= kMissedFactor * tolerance && w.allFinite() && s.allFinite();
 }
 
@@ -178,6 +184,7 @@ std::optional<Vector> MatrixFreeBordered::solve(const Vector& u, const Residuals
     D << E.bottomRows(extra).transpose(), t.transpose();
     const detail::BorderedKrylov K(monodromy_products(maps_, y, p, q, period_), open_.at(p, q), B,
                                    C, D);
+    outer_space_.operator_changed();
     for (Index i = 0; i <= m; ++i) {
       Vector rho = Vector::Zero(extra);
       if (i == 0) {
@@ -187,7 +194,8 @@ std::optional<Vector> MatrixFreeBordered::solve(const Vector& u, const Residuals
       }
       Vector x, s;
       const detail::GmresResult g = K.solve(i == 0 ? r : Vector::Zero(n_), rho, x, s, tolerance,
-                                            shooting.gmres_dimension, shooting.gmres_restarts);
+                                            shooting.gmres_dimension, shooting.gmres_restarts,
+                                            &outer_space_);
       if (g.relative_residual > kMissedFactor * tolerance) return std::nullopt;
       Vector z(u.size());
       z << x, s;
@@ -277,6 +285,7 @@ void MatrixFreeBordered::refresh() {
   }
   border_ = orthonormal_columns(last_.W);
   last_at_.resize(0);  // G depends on the borders
+  inner_at_.resize(0);  // and so does the inner operator
   transverse_.resize(0, 0);  // the next choice from the next point's products
 }
 

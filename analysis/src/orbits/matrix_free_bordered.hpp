@@ -66,6 +66,7 @@
 #include <optional>
 
 #include "orbits/curve_systems.hpp"
+#include "orbits/gmres.hpp"
 #include "orbits/matrix_free_curve.hpp"
 
 namespace pwl::orbits::curves_detail {
@@ -131,6 +132,11 @@ class MatrixFreeBordered : public CurveSystem, public MatrixFreeCurve {
   std::optional<CurvePreconditioner> condition_;  // (M0 + I)⁻¹ or (M0² − 2κM0 + I)⁻¹
   Residuals last_;
   Vector last_at_;
+  // GMRES's recycled subspaces (gmres.hpp): of the inner system [A, B; Bᵀ, 0], whose k(m + 2)
+  // right-hand sides of a Newton step share one operator (at inner_at_), and of K, whose m + 1
+  // share another. A new point forms their images again.
+  detail::RecycledSubspace inner_space_, outer_space_;
+  Vector inner_at_;
   // G's entries' products along the c_i of the last step that succeeded (k² × m; Neimark–Sacker:
   // 4 × 2), emptied at each accepted point.
   Matrix transverse_;

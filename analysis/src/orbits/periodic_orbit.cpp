@@ -40,6 +40,11 @@ bool ShootingOptions::is_valid(std::string* why) const {
                        gmres_dimension, gmres_restarts);
     return false;
   }
+  if (gmres_recycled < 0 || gmres_recycled >= gmres_dimension) {
+    *why = fmt::format("gmres recycled = {} must lie in [0, gmres dimension = {})", gmres_recycled,
+                       gmres_dimension);
+    return false;
+  }
   if (shots > 1 && solver == ShootingSolver::krylov) {
     *why = fmt::format("shots = {}: multiple shooting needs the dense solver", shots);
     return false;
@@ -259,6 +264,7 @@ PeriodicOrbit find_periodic_orbit(StroboscopicMap& map, const Vector& guess,
   }
   double forcing = 1e-2, previous_residual = 0;
   long krylov_products = 0;
+  detail::RecycledSubspace recycled(options.gmres_recycled);
   Vector y = guess;
   Vector F = map.advance(y, options.period) - y;
   double residual = inf_norm(F);
@@ -296,8 +302,9 @@ PeriodicOrbit find_periodic_orbit(StroboscopicMap& map, const Vector& guess,
     }
     forcing = std::max(forcing, 0.5 * options.tolerance * std::max(1.0, inf_norm(y)) / residual);
     Vector u;
-    const detail::GmresResult g =
-        detail::gmres(apply, -F, u, forcing, options.gmres_dimension, options.gmres_restarts);
+    recycled.operator_changed();  // the map's derivative at the new iterate
+    const detail::GmresResult g = detail::gmres(apply, -F, u, forcing, options.gmres_dimension,
+                                                options.gmres_restarts, &recycled);
     krylov_products += g.products;
     const Vector delta = precondition(u);
     previous_residual = residual;

@@ -69,6 +69,11 @@ void add_orbit_flags(CLI::App& c, OrbitFlags& f, bool with_dt) {
                "no partner within half this at the step's other end (one to one), so that one\n"
                "moving less than that in a step does not leave the circle and come back unseen")
       ->check(number_check({0.0, 1.0, false, true, "a number in [0, 1)"}, "[0,1)"));
+  c.add_option("--gmres-recycle", f.gmres_recycle,
+               "Krylov: vectors GMRES carries from one solve to the next of the same operator\n"
+               "(GCRO-DR: the harmonic Ritz vectors of its smallest eigenvalues), below GMRES's 60;\n"
+               "0: none")
+      ->check(number_check({0.0, 60.0, false, true, "a whole number in [0, 60)"}, "[0,60)"));
   c.add_option("--out", f.out, "Output folder");
   c.add_flag("--quiet", f.quiet, "No progress on standard error");
 }
@@ -190,6 +195,11 @@ void check_orbit_flags(const OrbitFlags& f) {
     throw InputError(
         fmt::format("--multiplier-margin = {} must be in [0, 1)", f.multiplier_margin));
   }
+  const orbits::ShootingOptions defaults;
+  if (f.gmres_recycle < 0 || f.gmres_recycle >= defaults.gmres_dimension) {
+    throw InputError(fmt::format("--gmres-recycle = {} must be in [0, {})", f.gmres_recycle,
+                                 defaults.gmres_dimension));
+  }
 }
 
 orbits::ShootingOptions shooting_options(const OrbitFlags& f) {
@@ -198,6 +208,7 @@ orbits::ShootingOptions shooting_options(const OrbitFlags& f) {
   s.tolerance = f.newton_tolerance;
   s.max_iterations = f.max_iterations;
   s.arnoldi.margin = f.multiplier_margin;
+  s.gmres_recycled = f.gmres_recycle;
   return s;
 }
 
