@@ -101,9 +101,12 @@ void orbit(const OrbitCommandFlags& f) {
                                 ? fmt::format("the state {} forcing periods after {}", o.transient, o.run.start.text())
                                 : o.guess_file);
   fmt::print("Newton: {} iteration(s), residual |φ(y) − y|_∞ = {:.3e} (tolerance {:.1e}), {} "
-             "integrations of the map, {} solver{}\n",
+             "integrations of the map, {} solver{}{}\n",
              orbit.iterations, orbit.residual, o.newton_tolerance, orbit.evaluations,
              orbits::shooting_solver_name(orbit.solver),
+             orbit.solver == orbits::ShootingSolver::krylov
+                 ? fmt::format(" ({} GMRES products)", orbit.krylov_products)
+                 : std::string(),
              f.shots > 1 ? fmt::format(", {} shots", f.shots) : std::string());
   if (!mu.values.empty()) {
     fmt::print("Floquet multipliers: {} ({}), largest |μ| = {:.10g} (μ = {}){}\n",

@@ -74,6 +74,9 @@ void add_orbit_flags(CLI::App& c, OrbitFlags& f, bool with_dt) {
                "(GCRO-DR: the harmonic Ritz vectors of its smallest eigenvalues), below GMRES's 60;\n"
                "0: none")
       ->check(number_check({0.0, 60.0, false, true, "a whole number in [0, 60)"}, "[0,60)"));
+  c.add_flag("--no-precondition", f.no_precondition,
+             "Krylov: GMRES without the open structure's preconditioner (as it runs where the\n"
+             "damping is not classical), for comparison");
   c.add_option("--out", f.out, "Output folder");
   c.add_flag("--quiet", f.quiet, "No progress on standard error");
 }
@@ -209,6 +212,7 @@ orbits::ShootingOptions shooting_options(const OrbitFlags& f) {
   s.max_iterations = f.max_iterations;
   s.arnoldi.margin = f.multiplier_margin;
   s.gmres_recycled = f.gmres_recycle;
+  s.precondition = !f.no_precondition;
   return s;
 }
 

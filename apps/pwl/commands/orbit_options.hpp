@@ -24,6 +24,7 @@ struct OrbitFlags {
   int transient = 200;         // forcing periods from rest before the guess is taken
   double multiplier_margin = 0.0;  // Arnoldi reports every multiplier with |μ| > 1 − this
   int gmres_recycle = 10;      // Krylov: vectors GMRES recycles (ShootingOptions::gmres_recycled)
+  bool no_precondition = false;  // Krylov: GMRES without the open structure's preconditioner
   std::string guess_file;      // a state file instead of the transient
   std::string out = "orbit";
   bool quiet = false;
@@ -31,7 +32,7 @@ struct OrbitFlags {
 
 // The case flags (add_case_options, without --periods and --skip-periods, which an orbit does not
 // use, and without --dt unless `with_dt`), --period, --newton-tol, --max-iterations, --transient,
-// --guess-file, --multiplier-margin, --gmres-recycle, --out and --quiet. --method's default becomes the orbit
+// --guess-file, --multiplier-margin, --gmres-recycle, --no-precondition, --out and --quiet. --method's default becomes the orbit
 // default (orbit_method).
 void add_orbit_flags(CLI::App& command, OrbitFlags& flags, bool with_dt);
 // To be called from the command's callback: records whether --method was given.
