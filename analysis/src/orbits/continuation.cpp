@@ -1137,7 +1137,8 @@ class Continuer {
   bool chord_ = true;  // the corrector: chord steps, or Newton
   bool matrix_free_ = false;  // beyond the dense limit: Newton-Krylov and Arnoldi
   std::optional<detail::OpenStructurePreconditioner> open_;  // matrix-free: GMRES's preconditioner
-  // Matrix-free: GMRES's recycled subspace (gmres.hpp), from one bordered system to the next.
+  // Matrix-free: GMRES's recycled subspace (gmres.hpp), kept across a solve's restarts and
+  // dropped at each new bordered system.
   detail::RecycledSubspace recycled_;
   const ContinuationOptions& options_;
   ContinuationObserver* observer_;

@@ -134,7 +134,7 @@ class MatrixFreeBordered : public CurveSystem, public MatrixFreeCurve {
   Vector last_at_;
   // GMRES's recycled subspaces (gmres.hpp): of the inner system [A, B; Bᵀ, 0], whose k(m + 2)
   // right-hand sides of a Newton step share one operator (at inner_at_), and of K, whose m + 1
-  // share another. A new point forms their images again.
+  // share another. A new point drops them (gmres.hpp says why).
   detail::RecycledSubspace inner_space_, outer_space_;
   Vector inner_at_;
   // G's entries' products along the c_i of the last step that succeeded (k² × m; Neimark–Sacker:

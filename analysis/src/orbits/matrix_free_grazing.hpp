@@ -72,7 +72,7 @@ class MatrixFreeGrazing : public GrazingSystem, public MatrixFreeCurve {
   bool solve(const Vector& u, const Linearised& l, const Vector& tau, const Vector& r,
              const Vector& rho, Vector& delta, double tolerance);
   CurvePreconditioner open_;
-  detail::RecycledSubspace recycled_;  // GMRES's, from one step's system to the next (gmres.hpp)
+  detail::RecycledSubspace recycled_;  // GMRES's across a solve's restarts (gmres.hpp)
   // The residuals of the last u evaluated (the tangent at a corrected point reuses them).
   Linearised last_;
   Vector last_at_;
