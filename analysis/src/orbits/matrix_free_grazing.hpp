@@ -36,7 +36,6 @@
 #include <optional>
 
 #include "orbits/curve_systems.hpp"
-#include "orbits/gmres.hpp"
 #include "orbits/matrix_free_curve.hpp"
 
 namespace pwl::orbits::curves_detail {
@@ -72,7 +71,6 @@ class MatrixFreeGrazing : public GrazingSystem, public MatrixFreeCurve {
   bool solve(const Vector& u, const Linearised& l, const Vector& tau, const Vector& r,
              const Vector& rho, Vector& delta, double tolerance);
   CurvePreconditioner open_;
-  detail::RecycledSubspace recycled_;  // GMRES's across a solve's restarts (gmres.hpp)
   // The residuals of the last u evaluated (the tangent at a corrected point reuses them).
   Linearised last_;
   Vector last_at_;

@@ -264,7 +264,6 @@ PeriodicOrbit find_periodic_orbit(StroboscopicMap& map, const Vector& guess,
   }
   double forcing = 1e-2, previous_residual = 0;
   long krylov_products = 0;
-  detail::RecycledSubspace recycled(options.gmres_recycled);
   Vector y = guess;
   Vector F = map.advance(y, options.period) - y;
   double residual = inf_norm(F);
@@ -302,7 +301,8 @@ PeriodicOrbit find_periodic_orbit(StroboscopicMap& map, const Vector& guess,
     }
     forcing = std::max(forcing, 0.5 * options.tolerance * std::max(1.0, inf_norm(y)) / residual);
     Vector u;
-    recycled.operator_changed();  // the map's derivative at the new iterate
+    // Recycled across this solve's restarts only: the map's derivative changes with the iterate.
+    detail::RecycledSubspace recycled(options.gmres_recycled);
     const detail::GmresResult g = detail::gmres(apply, -F, u, forcing, options.gmres_dimension,
                                                 options.gmres_restarts, &recycled);
     krylov_products += g.products;
