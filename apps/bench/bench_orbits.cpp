@@ -163,7 +163,7 @@ struct ShootingGroup {
 
 std::string stable_text(const ShootingRow& r) {
   if (!r.converged) return "-";
-  if (!r.multipliers_converged) return "undetermined (Arnoldi not converged)";
+  if (!r.multipliers_converged) return "undetermined (multipliers not converged)";
   return r.stable ? "yes" : "no";
 }
 
@@ -595,7 +595,7 @@ std::string format_tables(const OrbitBenchOptions& o, const std::vector<Shooting
         }
         const std::string multipliers =
             r.complete ? fmt::format("all {}", r.multipliers)
-                       : fmt::format("leading {} (Arnoldi{})", r.multipliers,
+                       : fmt::format("leading {} (Krylov{})", r.multipliers,
                                      r.multipliers_converged
                                          ? ""
                                          : fmt::format(", residual {:.1e}", r.arnoldi_residual));
@@ -633,7 +633,7 @@ std::string format_tables(const OrbitBenchOptions& o, const std::vector<Shooting
         const MultiplierCheck& c = g.check;
         t += fmt::format(
             "\n{}, n = {}: the whole {} x {} monodromy at the Newton-Krylov orbit ({:.3g} s to form, "
-            "{:.3g} s for its eigenvalues): {} outside the unit circle, ρ(M) = {:.9g}; Arnoldi's "
+            "{:.3g} s for its eigenvalues): {} outside the unit circle, ρ(M) = {:.9g}; the Krylov "
             "{} leading multipliers are its leading ones to {:.1e}.\n",
             g.spec.label, g.spec.chain.masses, c.size, c.size, c.form_seconds, c.eigen_seconds,
             c.outside, c.radius, c.compared, c.distance);
@@ -682,12 +682,12 @@ std::string format_tables(const OrbitBenchOptions& o, const std::vector<Shooting
       if (!header) {
         t += fmt::format(
             "\n\nMatrix-free continuation (no monodromy: Newton–Krylov on the bordered system, "
-            "leading multipliers by warm-started Arnoldi), against a cold orbit (Newton–Krylov "
-            "and Arnoldi from the same guess, as `pwl orbit`) at the start in the same run "
+            "leading multipliers by warm-started preconditioned Davidson, or Arnoldi), against a cold orbit (Newton–Krylov "
+            "and the multipliers from the same guess, as `pwl orbit`) at the start in the same run "
             "(medians of {} runs):\n\n",
             o.repeats);
         t += "| case | n | θ asked | θ reached | points | cold orbit s | warm point s | warm / "
-             "cold | GMRES products per point | Arnoldi products per point | bifurcations | "
+             "cold | GMRES products per point | multiplier products per point | bifurcations | "
              "total s | peak memory MB | why it stopped |\n";
         t += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
         header = true;

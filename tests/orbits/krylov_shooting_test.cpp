@@ -13,6 +13,7 @@
 #include <tuple>
 #include <vector>
 
+#include "known_spectra.hpp"
 #include "orbit_cases.hpp"
 #include "pwl/model/chain_builders.hpp"
 #include "pwl/orbits/orbit_profile.hpp"
@@ -21,28 +22,15 @@
 using namespace pwl;
 using namespace pwl::orbits;
 using pwl::test::measured;
+using pwl::test::put_pair;
 using pwl::test::set_distance;
 using Complex = std::complex<double>;
 
 namespace {
 
-// The 2x2 rotation-scaling block of the pair r e^{±iφ}, at (i, i) of D.
-void put_pair(Matrix& D, Index i, double r, double phi) {
-  D(i, i) = D(i + 1, i + 1) = r * std::cos(phi);
-  D(i, i + 1) = r * std::sin(phi);
-  D(i + 1, i) = -r * std::sin(phi);
-}
-
-// S D S⁻¹ with S a random well-conditioned basis: an orthogonal Q bent by 5%, both from uniform
-// draws in [-1, 1] of `rng`.
+// S D S⁻¹ with S a random well-conditioned basis (known_spectra.hpp).
 Matrix similar_to(const Matrix& D, std::mt19937& rng) {
-  const Index n = D.rows();
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  Matrix random(n, n);
-  for (Index i = 0; i < n; ++i)
-    for (Index j = 0; j < n; ++j) random(i, j) = u(rng);
-  const Matrix Q = Eigen::HouseholderQR<Matrix>(random).householderQ();
-  const Matrix S = Q * (Matrix::Identity(n, n) + 0.05 * random / std::sqrt(double(n)));
+  const Matrix S = pwl::test::random_basis(D.rows(), rng);
   return S * D * S.inverse();
 }
 

@@ -136,7 +136,8 @@ TEST_CASE("with GMRES recycling the matrix-free branch is the same branch", "[or
 
 TEST_CASE("matrix-free continuation claims no stability change from multipliers that did not converge",
           "[orbits]") {
-  // The same branch with Arnoldi starved (a basis of 3 for 10 state components, no restart): its
+  // The same branch with the eigen-solver starved (a basis of 3 for 10 state components, no
+  // restart; Arnoldi's and Davidson's alike): its
   // Ritz values are not the multipliers, and the period doubling the dense continuation locates
   // on this branch must not be claimed from them, nor any other stability change; the result
   // counts the points and says why in a note.
@@ -145,6 +146,7 @@ TEST_CASE("matrix-free continuation claims no stability change from multipliers 
   ContinuationOptions o = figure_4a_options(method);
   o.shooting.arnoldi.count = 2;
   o.shooting.arnoldi.krylov_dimension = 3;
+  o.shooting.arnoldi.davidson_dimension = 3;
   o.shooting.arnoldi.max_restarts = 0;
   const ContinuationResult starved =
       follow(chain, figure_4a_orbit(chain, method), o, ShootingSolver::krylov);

@@ -41,6 +41,7 @@ TEST_CASE("a long chain's period-doubling curve, matrix-free, is the dense one",
   o.steps_per_period = 200;
   o.max_points = 40;
   o.shooting.arnoldi.krylov_dimension = 120;
+  o.shooting.arnoldi.davidson_dimension = 120;
   const ContinuationResult branch = pwl::test::follow(chain, guess, o, ShootingSolver::krylov);
   const Bifurcation* doubling = pwl::test::first_doubling(branch);
   REQUIRE(doubling != nullptr);

@@ -48,9 +48,11 @@ TEST_CASE("a long chain's period doubling, matrix-free: located as dense and swi
   o.max_points = 40;
   o.switch_branches = true;
   o.max_branches = 1;
-  // A basis smaller than the 200 state components, so that Arnoldi restarts as on a longer chain
-  // (a basis as large as the operator would make its Ritz values exact in one cycle).
+  // A basis smaller than the 200 state components, so that the eigen-solver (Davidson here:
+  // the chain's damping is classical) restarts as on a longer chain (a basis as large as the
+  // operator would make its Ritz values exact in one cycle).
   o.shooting.arnoldi.krylov_dimension = 120;
+  o.shooting.arnoldi.davidson_dimension = 120;
   const ContinuationResult dense = follow(chain, guess, o, ShootingSolver::dense);
   const ContinuationResult free = follow(chain, guess, o, ShootingSolver::krylov);
   REQUIRE_FALSE(dense.matrix_free);

@@ -12,6 +12,7 @@
 #include <set>
 
 #include "orbits/bordered_krylov.hpp"
+#include "orbits/leading_multipliers.hpp"
 #include "orbits/multiplier_movement.hpp"
 #include "orbits/newton_krylov.hpp"
 #include "orbits/open_structure_preconditioner.hpp"
@@ -370,12 +371,12 @@ class Continuer {
     const Vector y = pt.y();
     ArnoldiOptions arnoldi = options_.shooting.arnoldi;
     arnoldi.block = map.tangent_block();
-    pt.mu = leading_floquet_multipliers(
+    pt.mu = detail::leading_multipliers(
         [&](Matrix& v) {
           map.advance(y, period, v);
           result_.arnoldi_products += v.cols();
         },
-        y.size(), arnoldi, warm, &pt.ritz);
+        y.size(), arnoldi, open_at(pt.p(), period), warm, &pt.ritz);
     if (!pt.mu.converged) ++result_.unconverged_multipliers;
     if (pt.mu.converged && !pt.mu.band_covered) ++result_.uncovered_bands;
   }

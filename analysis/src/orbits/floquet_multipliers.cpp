@@ -8,37 +8,13 @@
 #include <fmt/format.h>
 #include <random>
 
+#include "orbits/multiplier_sorting.hpp"
 #include "pwl/errors.hpp"
 
 namespace pwl::orbits {
 
-namespace {
-
-// Largest modulus first; ties (a conjugate pair) with the positive imaginary part first.
-void sort_multipliers(std::vector<std::complex<double>>& values) {
-  std::stable_sort(values.begin(), values.end(),
-                   [](const std::complex<double>& a, const std::complex<double>& b) {
-                     const double ma = std::abs(a), mb = std::abs(b);
-                     if (std::abs(ma - mb) > 1e-12 * std::max(ma, mb)) return ma > mb;
-                     return a.imag() > b.imag();
-                   });
-}
-
-// x minus its projection on the orthonormal columns of `basis`, the coefficients added to h, by
-// classical Gram-Schmidt twice: as orthogonal to rounding as modified Gram-Schmidt twice ("twice
-// is enough": L. Giraud, J. Langou, M. Rozloznik, Comput. Math. Appl. 50 (2005) 1069-1075), in
-// two matrix-vector products with the basis a pass instead of a dot product and an update per
-// column.
-template <class Basis, class Column, class Coefficients>
-void project_out_twice(const Basis& basis, Column&& x, Coefficients&& h) {
-  for (int pass = 0; pass < 2; ++pass) {
-    const Vector c = basis.transpose() * x;
-    h += c;
-    x.noalias() -= basis * c;
-  }
-}
-
-}  // namespace
+using detail::project_out_twice;
+using detail::sort_multipliers;
 
 double FloquetMultipliers::largest_modulus() const {
   return values.empty() ? 0.0 : std::abs(values.front());
@@ -88,6 +64,11 @@ bool ArnoldiOptions::is_valid(std::string* why) const {
                        krylov_dimension, count);
     return false;
   }
+  if (davidson_dimension <= count) {
+    *why = fmt::format("davidson dimension = {} must exceed the count of multipliers {}",
+                       davidson_dimension, count);
+    return false;
+  }
   if (max_restarts < 0) {
     *why = fmt::format("max restarts = {} must be >= 0", max_restarts);
     return false;
@@ -128,6 +109,7 @@ FloquetMultipliers leading_floquet_multipliers(const std::function<void(Matrix&)
   }
 
   FloquetMultipliers result;
+  result.method = FloquetMultipliers::Method::arnoldi;
   result.complete = wanted == size;
   // Block Krylov-Schur: apply() takes `block` columns at a time (a caller can spread them over
   // threads). The relation A V_j = V_j G_j + V_next E, E nonzero in its last block of columns
@@ -290,22 +272,7 @@ FloquetMultipliers leading_floquet_multipliers(const std::function<void(Matrix&)
     sort_multipliers(result.values);
     return result;
   }
-  // Sorted with their vectors.
-  std::vector<std::complex<double>> sorted = result.values;
-  sort_multipliers(sorted);
-  Eigen::MatrixXcd arranged(size, static_cast<Index>(sorted.size()));
-  std::vector<bool> used(sorted.size(), false);
-  for (std::size_t i = 0; i < sorted.size(); ++i) {
-    for (std::size_t j = 0; j < sorted.size(); ++j) {
-      if (!used[j] && result.values[j] == sorted[i]) {
-        arranged.col(static_cast<Index>(i)) = vectors->col(static_cast<Index>(j));
-        used[j] = true;
-        break;
-      }
-    }
-  }
-  *vectors = std::move(arranged);
-  result.values = std::move(sorted);
+  sort_multipliers(result.values, *vectors);
   return result;
 }
 

@@ -129,9 +129,11 @@ class OpenStructurePreconditioner {
     if (!available_) return;
     const Index n = omega2_.size();
     inverse_.resize(n);
+    exp_.resize(n);
     for (Index k = 0; k < n; ++k) {
       const double w2 = std::max(0.0, omega2_(k));
       const Eigen::Matrix2d E = exp2x2(w2, modal_damping_(k), tau);
+      exp_[k] = E;
       const Eigen::Matrix2d J =
           kappa_ ? Eigen::Matrix2d(E * E - 2 * *kappa_ * E + Eigen::Matrix2d::Identity())
                  : Eigen::Matrix2d(E - shift_ * Eigen::Matrix2d::Identity());
@@ -149,18 +151,63 @@ class OpenStructurePreconditioner {
   Vector apply(const Vector& r) const {
     const Index n = omega2_.size();
     Vector qx, qv;
-    if (chain_) {
-      chain_->to_modal(r.head(n), r.tail(n), qx, qv);
-    } else {
-      qx = phi_.transpose() * (mass_ * r.head(n));
-      qv = phi_.transpose() * (mass_ * r.tail(n));
-    }
+    to_modal(r, qx, qv);
     Vector zx(n), zv(n);
     for (Index k = 0; k < n; ++k) {
       const Eigen::Vector2d z = inverse_[k] * Eigen::Vector2d(qx(k), qv(k));
       zx(k) = z(0);
       zv(k) = z(1);
     }
+    return from_modal(zx, zv);
+  }
+
+  // (M0 − σI)⁻¹ r for a complex shift σ and a complex r: the preconditioner of the Davidson
+  // iteration for the leading multipliers (preconditioned_floquet_multipliers), σ its current
+  // Ritz value. The same modal coordinates (the real and imaginary parts each), each block
+  // E_k − σI inverted in complex arithmetic (2 x 2: O(n) besides the transforms); a block
+  // singular to rounding (σ on an eigenvalue of M0 to 1e-14) is taken as the identity.
+  Eigen::VectorXcd shifted_inverse(const Eigen::VectorXcd& r, std::complex<double> sigma) const {
+    const Index n = omega2_.size();
+    Vector qxr, qvr, qxi, qvi;
+    to_modal(r.real(), qxr, qvr);
+    to_modal(r.imag(), qxi, qvi);
+    Vector zxr(n), zvr(n), zxi(n), zvi(n);
+    for (Index k = 0; k < n; ++k) {
+      Eigen::Matrix2cd J = exp_[k].cast<std::complex<double>>();
+      J(0, 0) -= sigma;
+      J(1, 1) -= sigma;
+      const std::complex<double> det = J(0, 0) * J(1, 1) - J(0, 1) * J(1, 0);
+      const Eigen::Vector2cd q(std::complex<double>(qxr(k), qxi(k)),
+                               std::complex<double>(qvr(k), qvi(k)));
+      Eigen::Vector2cd z = q;
+      if (std::abs(det) > 1e-14 * std::max(1.0, J.cwiseAbs().maxCoeff())) {
+        z(0) = (J(1, 1) * q(0) - J(0, 1) * q(1)) / det;
+        z(1) = (J(0, 0) * q(1) - J(1, 0) * q(0)) / det;
+      }
+      zxr(k) = z(0).real();
+      zxi(k) = z(0).imag();
+      zvr(k) = z(1).real();
+      zvi(k) = z(1).imag();
+    }
+    Eigen::VectorXcd out(2 * n);
+    out.real() = from_modal(zxr, zvr);
+    out.imag() = from_modal(zxi, zvi);
+    return out;
+  }
+
+ private:
+  // The modal coordinates q = Φ^T M r of the two halves of a state vector, and back (Φ z).
+  void to_modal(const Vector& r, Vector& qx, Vector& qv) const {
+    const Index n = omega2_.size();
+    if (chain_) {
+      chain_->to_modal(r.head(n), r.tail(n), qx, qv);
+    } else {
+      qx = phi_.transpose() * (mass_ * r.head(n));
+      qv = phi_.transpose() * (mass_ * r.tail(n));
+    }
+  }
+  Vector from_modal(const Vector& zx, const Vector& zv) const {
+    const Index n = omega2_.size();
     Vector out(2 * n);
     if (chain_) {
       chain_->from_modal(zx, zv, out.head(n), out.tail(n));
@@ -171,7 +218,6 @@ class OpenStructurePreconditioner {
     return out;
   }
 
- private:
   // exp(τ [[0, 1], [−ω², −c]]) in closed form (by the eigenvalues of the 2 x 2 block, which may be
   // real, complex or double).
   static Eigen::Matrix2d exp2x2(double w2, double c, double tau) {
@@ -251,6 +297,7 @@ class OpenStructurePreconditioner {
   SparseMatrix mass_;
   std::optional<FixedFreeChainModes> chain_;  // instead of Φ for a uniform fixed-free chain
   std::vector<Eigen::Matrix2d> inverse_;
+  std::vector<Eigen::Matrix2d> exp_;  // E_k = exp(τ A_k), the modal blocks of M0
 };
 
 }  // namespace pwl::orbits::detail

@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "orbits/gmres.hpp"
+#include "orbits/leading_multipliers.hpp"
 #include "orbits/open_structure_preconditioner.hpp"
 
 namespace pwl::orbits {
@@ -77,6 +78,20 @@ bool uses_dense_solver(const StroboscopicMap& map, const ShootingOptions& option
   return true;
 }
 
+namespace {
+
+// The leading multipliers without the monodromy, preconditioned by `open` where given.
+FloquetMultipliers krylov_multipliers(StroboscopicMap& map, const Vector& state,
+                                      const ShootingOptions& options,
+                                      const detail::OpenStructurePreconditioner* open) {
+  ArnoldiOptions arnoldi = options.arnoldi;
+  arnoldi.block = map.tangent_block();
+  return detail::leading_multipliers(
+      [&](Matrix& v) { map.advance(state, options.period, v); }, map.state_size(), arnoldi, open);
+}
+
+}  // namespace
+
 FloquetMultipliers orbit_multipliers(StroboscopicMap& map, const Vector& state,
                                      const ShootingOptions& options, Matrix* monodromy) {
   if (uses_dense_solver(map, options)) {
@@ -86,10 +101,11 @@ FloquetMultipliers orbit_multipliers(StroboscopicMap& map, const Vector& state,
     if (monodromy != nullptr) *monodromy = std::move(M);
     return mu;
   }
-  ArnoldiOptions arnoldi = options.arnoldi;
-  arnoldi.block = map.tangent_block();
-  return leading_floquet_multipliers(
-      [&](Matrix& v) { map.advance(state, options.period, v); }, map.state_size(), arnoldi);
+  std::optional<detail::OpenStructurePreconditioner> open;
+  if (options.precondition && options.arnoldi.method == ArnoldiOptions::Method::automatic) {
+    open.emplace(map.structure(), options.period * map.forcing_period());
+  }
+  return krylov_multipliers(map, state, options, open ? &*open : nullptr);
 }
 
 namespace {
@@ -146,7 +162,8 @@ MapCounts counts(const StroboscopicMap& map) { return {map.evaluations(), map.ta
 
 PeriodicOrbit finish(StroboscopicMap& map, const ShootingOptions& options, Vector state,
                      double residual, int iterations, bool dense, Matrix monodromy,
-                     const MapCounts& before) {
+                     const MapCounts& before,
+                     const detail::OpenStructurePreconditioner* open = nullptr) {
   PeriodicOrbit orbit;
   orbit.state = std::move(state);
   orbit.period = options.period;
@@ -160,7 +177,8 @@ PeriodicOrbit finish(StroboscopicMap& map, const ShootingOptions& options, Vecto
       orbit.multipliers = floquet_multipliers(monodromy);
       orbit.monodromy = std::move(monodromy);
     } else {
-      orbit.multipliers = orbit_multipliers(map, orbit.state, options);
+      orbit.multipliers = open != nullptr ? krylov_multipliers(map, orbit.state, options, open)
+                                          : orbit_multipliers(map, orbit.state, options);
     }
   }
   orbit.evaluations = map.evaluations() - before.evaluations;
@@ -269,7 +287,8 @@ PeriodicOrbit find_periodic_orbit(StroboscopicMap& map, const Vector& guess,
   double residual = inf_norm(F);
   const auto krylov_answer = [&](int iteration) {
     PeriodicOrbit orbit =
-        finish(map, options, y, residual, iteration, false, Matrix(), before);
+        finish(map, options, y, residual, iteration, false, Matrix(), before,
+               preconditioner ? &*preconditioner : nullptr);
     orbit.krylov_products = krylov_products;
     orbit.preconditioned = preconditioner && preconditioner->available();
     return orbit;

@@ -429,17 +429,17 @@ void continue_orbit(const ContinueFlags& f) {
     for (const std::string& note : result.notes) fmt::print("  {}\n", note);
   }
   if (result.matrix_free) {
-    fmt::print("work (matrix-free): {} GMRES products, {} Arnoldi products, {} other integrations "
+    fmt::print("work (matrix-free): {} GMRES products, {} multiplier products, {} other integrations "
                "of the map; {} step(s) cut to explain the multipliers' signature\n",
                result.krylov_products, result.arnoldi_products, result.integrations,
                result.step_cuts);
     if (result.unconverged_multipliers > 0) {
-      fmt::print("  at {} point(s) Arnoldi stopped short of its tolerance: their stability rests on "
+      fmt::print("  at {} point(s) the multipliers stopped short of their tolerance: their stability rests on "
                  "unconverged Ritz values\n",
                  result.unconverged_multipliers);
     }
     if (result.uncovered_bands > 0) {
-      fmt::print("  at {} point(s) Arnoldi's multipliers stopped at half its basis still above {:.6g} "
+      fmt::print("  at {} point(s) the multipliers stopped at half their basis still above {:.6g} "
                  "in modulus: more of them may lie there than were reported\n",
                  result.uncovered_bands, 1.0 - c.shooting.arnoldi.margin);
     }
@@ -480,7 +480,7 @@ void continue_orbit(const ContinueFlags& f) {
     fmt::print("curves' work: {} monodromies, {} other integrations of the map\n",
                curves.monodromies, curves.integrations);
     if (curves.krylov_products > 0 || curves.arnoldi_products > 0) {
-      fmt::print("  matrix-free curves: {} GMRES products, {} Arnoldi products\n",
+      fmt::print("  matrix-free curves: {} GMRES products, {} multiplier products\n",
                  curves.krylov_products, curves.arnoldi_products);
       if (curves.unconverged_multipliers > 0 || curves.uncovered_bands > 0) {
         fmt::print("  at {} corrected point(s) Arnoldi stopped short of its tolerance and at {} it "

@@ -110,7 +110,9 @@ void orbit(const OrbitCommandFlags& f) {
              f.shots > 1 ? fmt::format(", {} shots", f.shots) : std::string());
   if (!mu.values.empty()) {
     fmt::print("Floquet multipliers: {} ({}), largest |μ| = {:.10g} (μ = {}){}\n",
-               mu.values.size(), mu.complete ? "all" : "the leading ones, by Arnoldi",
+               mu.values.size(),
+               mu.complete ? std::string("all")
+                           : fmt::format("the leading ones, by {}", eigen_solver_name(mu.method)),
                mu.largest_modulus(), multiplier_text(mu.values.front()),
                orbit.exact_tangent ? "" : ", from forward differences");
   }
@@ -127,12 +129,12 @@ void orbit(const OrbitCommandFlags& f) {
   fmt::print("amplitude max|x{}| over the orbit: {:.10g}\n", n, profile.amplitude(n - 1));
   const int outside = mu.unstable_count();
   if (!mu.converged) {
-    // Arnoldi's leading multipliers did not meet their tolerance: no verdict from them.
-    fmt::print("verdict: undetermined (Arnoldi did not converge: residual {:.1e}; {} of its "
+    // The leading multipliers did not meet their tolerance: no verdict from them.
+    fmt::print("verdict: undetermined ({} did not converge: residual {:.1e}; {} of its "
                "multipliers outside the unit circle)\n",
-               mu.residual, outside);
+               eigen_solver_name(mu.method), mu.residual, outside);
   } else {
-    // Arnoldi's count doubles until its smallest multiplier lies below 1 − margin; where it
+    // The eigen-solver's count doubles until its smallest multiplier lies below 1 − margin; where it
     // stopped at half its basis first, those outside may be more than it reports.
     const double margin = problem.shooting.arnoldi.margin;
     std::string band;
@@ -140,8 +142,8 @@ void orbit(const OrbitCommandFlags& f) {
       band = fmt::format("; every multiplier above {:.6g} in modulus is among the {}", 1 - margin,
                          mu.values.size());
     } else if (!mu.band_covered) {
-      band = fmt::format("; more may lie above {:.6g} in modulus: Arnoldi stopped at {} of them",
-                         1 - margin, mu.values.size());
+      band = fmt::format("; more may lie above {:.6g} in modulus: {} stopped at {} of them",
+                         1 - margin, eigen_solver_name(mu.method), mu.values.size());
     }
     fmt::print("verdict: {} ({}{} multiplier{} outside the unit circle{})\n",
                orbit.stable() ? "stable" : "unstable", mu.band_covered ? "" : "at least ",
@@ -168,6 +170,8 @@ OrbitProblem orbit_problem(const OrbitCommandFlags& f) {
   shooting.arnoldi.count = f.floquet_count;
   shooting.arnoldi.krylov_dimension =
       std::max(shooting.arnoldi.krylov_dimension, 2 * f.floquet_count + 10);
+  shooting.arnoldi.davidson_dimension =
+      std::max(shooting.arnoldi.davidson_dimension, 2 * f.floquet_count + 10);
   if (f.shots > 1 && shooting.solver == orbits::ShootingSolver::krylov) {
     throw InputError(fmt::format("--shots {}: multiple shooting needs --solver dense or automatic",
                                  f.shots));

@@ -69,6 +69,11 @@ void add_orbit_flags(CLI::App& c, OrbitFlags& f, bool with_dt) {
                "no partner within half this at the step's other end (one to one), so that one\n"
                "moving less than that in a step does not leave the circle and come back unseen")
       ->check(number_check({0.0, 1.0, false, true, "a number in [0, 1)"}, "[0,1)"));
+  c.add_option("--multiplier-method", f.multiplier_method,
+               "Krylov: automatic (Davidson preconditioned by the open structure where its damping\n"
+               "is classical: a long chain's crowd of long waves in a few products each; Arnoldi\n"
+               "elsewhere) or arnoldi (always thick-restarted Arnoldi), for comparison")
+      ->check(CLI::IsMember({"automatic", "arnoldi"}));
   c.add_option("--gmres-recycle", f.gmres_recycle,
                "Krylov: vectors GMRES carries from one solve to the next of the same operator\n"
                "(GCRO-DR: the harmonic Ritz vectors of its smallest eigenvalues), below GMRES's 60;\n"
@@ -211,9 +216,20 @@ orbits::ShootingOptions shooting_options(const OrbitFlags& f) {
   s.tolerance = f.newton_tolerance;
   s.max_iterations = f.max_iterations;
   s.arnoldi.margin = f.multiplier_margin;
+  s.arnoldi.method = f.multiplier_method == "arnoldi" ? orbits::ArnoldiOptions::Method::arnoldi
+                                                      : orbits::ArnoldiOptions::Method::automatic;
   s.gmres_recycled = f.gmres_recycle;
   s.precondition = !f.no_precondition;
   return s;
+}
+
+std::string eigen_solver_name(orbits::FloquetMultipliers::Method method) {
+  switch (method) {
+    case orbits::FloquetMultipliers::Method::dense: return "the dense monodromy";
+    case orbits::FloquetMultipliers::Method::arnoldi: return "Arnoldi";
+    case orbits::FloquetMultipliers::Method::davidson: return "Davidson";
+  }
+  return "?";
 }
 
 std::string multiplier_text(const std::complex<double>& mu) {

@@ -23,6 +23,7 @@ struct OrbitFlags {
   int max_iterations = 40;
   int transient = 200;         // forcing periods from rest before the guess is taken
   double multiplier_margin = 0.0;  // Arnoldi reports every multiplier with |μ| > 1 − this
+  std::string multiplier_method = "automatic";  // Krylov: "automatic" (Davidson where it can) or "arnoldi"
   int gmres_recycle = 10;      // Krylov: vectors GMRES recycles (ShootingOptions::gmres_recycled)
   bool no_precondition = false;  // Krylov: GMRES without the open structure's preconditioner
   std::string guess_file;      // a state file instead of the transient
@@ -32,7 +33,8 @@ struct OrbitFlags {
 
 // The case flags (add_case_options, without --periods and --skip-periods, which an orbit does not
 // use, and without --dt unless `with_dt`), --period, --newton-tol, --max-iterations, --transient,
-// --guess-file, --multiplier-margin, --gmres-recycle, --no-precondition, --out and --quiet. --method's default becomes the orbit
+// --guess-file, --multiplier-margin, --multiplier-method, --gmres-recycle, --no-precondition,
+// --out and --quiet. --method's default becomes the orbit
 // default (orbit_method).
 void add_orbit_flags(CLI::App& command, OrbitFlags& flags, bool with_dt);
 // To be called from the command's callback: records whether --method was given.
@@ -71,6 +73,9 @@ void check_orbit_flags(const OrbitFlags& flags);
 
 // "-1.2345+0.0123i".
 std::string multiplier_text(const std::complex<double>& mu);
+
+// "Arnoldi", "Davidson" or "the dense monodromy": how the multipliers were found.
+std::string eigen_solver_name(orbits::FloquetMultipliers::Method method);
 
 // The method's name for a line of text: "exact event-driven", "switching PIM, η = T/200".
 std::string orbit_method_label(const OrbitMethod& method);

@@ -21,6 +21,15 @@
 // 660 products (residual 7.6e-2), 100 thick-restarted vectors not in 1050, 150 converged in 800
 // products and 200 in 590 (residual 1e-15; the leading pair 0.999996 e^{±0.0131i}). The basis
 // takes 8 · size · (krylov_dimension + 1) bytes: 3.2 MB for 1000 masses, 320 MB for 10^5.
+// At 3000 masses and beyond the crowd outgrows any affordable basis and Arnoldi does not converge.
+//
+// Where the structure's linear part gives an approximate shifted inverse (the open structure's
+// (M0 − σI)⁻¹ under classical damping: pwl's Newton–Krylov preconditioner), a preconditioned
+// Davidson iteration (preconditioned_floquet_multipliers, below) separates the crowd by where each
+// multiplier lies in the plane instead of by modulus: on the paper's chain at θ = 1.5 the leading
+// six in 127 products at 1000 masses (Arnoldi: 690) and converged at 3000 and 10^4 masses, where
+// Arnoldi does not. Matrix-free shooting and continuation take it wherever it is available
+// (ArnoldiOptions::method).
 #include <complex>
 #include <functional>
 #include <string>
@@ -45,6 +54,10 @@ struct FloquetMultipliers {
   // (always for the dense ones; for Arnoldi, when it converged with its smallest value below
   // that, or reported all of them).
   bool band_covered = true;
+  // How they were found: the dense monodromy's eigenvalues, thick-restarted Arnoldi, or Davidson
+  // preconditioned by the open structure (preconditioned_floquet_multipliers).
+  enum class Method { dense, arnoldi, davidson };
+  Method method = Method::dense;
 
   double largest_modulus() const;
   // Asymptotically stable: every multiplier strictly inside the unit circle by more than
@@ -87,6 +100,19 @@ struct ArnoldiOptions {
   // and 1088 products for 6, 12, 48 and 96 multipliers (asked for directly, 32 or 64 take 704 and
   // 676: the crowd, not the count, sets the cost; the doublings add the restarts).
   double margin = 0.0;
+  // Where an approximate shifted inverse of the operator is at hand (the open structure's
+  // (M0 − σI)⁻¹ under classical damping), the leading multipliers can come from a preconditioned
+  // Davidson iteration instead (preconditioned_floquet_multipliers): `automatic` takes it there
+  // and Arnoldi elsewhere; `arnoldi` always Arnoldi. Davidson uses the same count, basis size
+  // (krylov_dimension), restarts, tolerance, seed, margin and warm start.
+  enum class Method { automatic, arnoldi };
+  Method method = Method::automatic;
+  // Davidson's basis, larger than Arnoldi's: a crowd has to be resolved before the first restart,
+  // which keeps only what the leading Ritz vectors hold. On the paper's chain at θ = 1.5
+  // (2026-12-01) its leading three pairs converged, unrestarted, at 127 columns for 1000 masses,
+  // 237 for 3000 and 485 for 10^4; with 200, restarted, 3000 masses had not converged after 800
+  // products. Fewer are used where V and M V (16 · size bytes a column) would exceed 1 GiB.
+  int davidson_dimension = 600;
   bool is_valid(std::string* why) const;
 };
 
@@ -108,5 +134,35 @@ FloquetMultipliers leading_floquet_multipliers(const std::function<void(Matrix&)
                                                Index size, const ArnoldiOptions& options = {},
                                                const Eigen::MatrixXcd* warm = nullptr,
                                                Eigen::MatrixXcd* vectors = nullptr);
+
+// An approximation K(σ) of M − σI for complex σ, applied inverted: z = K(σ)⁻¹ r. The open
+// structure's monodromy M0 (every gap spring open) gives one in O(n) or O(n log n) a vector when
+// the damping is classical (its 2 x 2 modal blocks).
+using ShiftedInverse =
+    std::function<Eigen::VectorXcd(const Eigen::VectorXcd& r, std::complex<double> sigma)>;
+
+// The same multipliers as leading_floquet_multipliers, by a preconditioned Davidson iteration:
+// the basis grows by the correction of the leading Ritz pair not yet converged (θ, u) with
+// residual r = M u − θ u, t = −K(θ)⁻¹ r + ε K(θ)⁻¹ u, ε making t orthogonal to u (Olsen's
+// correction: J. Olsen, P. Jørgensen and J. Simons, Chem. Phys. Lett. 169 (1990) 463-472; the
+// method after E. R. Davidson, J. Comput. Phys. 17 (1975) 87-94, and as one step of Jacobi-
+// Davidson, G. L. G. Sleijpen and H. A. van der Vorst, SIAM J. Matrix Anal. Appl. 17 (1996)
+// 401-425). The basis is real: a complex correction enters by its real and imaginary parts, one
+// block of two products. Rayleigh-Ritz on the basis gives the Ritz pairs, and their residuals are
+// computed from the products, not estimated.
+//
+// Why. A lightly damped long chain's long waves crowd the unit circle: moduli 1 − 4e-6 k² at
+// 1000 masses, 1 − 4e-8 k² at 10^4, at angles a few thousandths apart. Arnoldi separates them by
+// modulus and needs a basis about as large as the crowd (590–690 products at 1000 masses, no
+// convergence at 3000 or 10^4 in 200 vectors); K(θ)⁻¹ separates them by where they are in the
+// plane, a shift-and-invert by the structure's linear part, so each converges in a few products
+// whatever the crowd. Start: the warm Ritz vectors (real and imaginary parts) when given, a fixed
+// random vector and K(1)⁻¹ of it (the long waves, near 1). Restart at `krylov_dimension` columns
+// to the span of the leading Ritz vectors, half the basis. Throws InputError for invalid options.
+FloquetMultipliers preconditioned_floquet_multipliers(const std::function<void(Matrix&)>& apply,
+                                                      const ShiftedInverse& inverse, Index size,
+                                                      const ArnoldiOptions& options = {},
+                                                      const Eigen::MatrixXcd* warm = nullptr,
+                                                      Eigen::MatrixXcd* vectors = nullptr);
 
 }  // namespace pwl::orbits
