@@ -626,7 +626,7 @@ TEST_CASE("banded switching PIM: no replay unless recording; others refuse to re
 }
 
 TEST_CASE("banded switching PIM: local and global switch corrections agree",
-          "[banded][switching][local]") {
+          "[banded][switching][local][release-only]") {
   // 1000 steps of a chain whose springs switch all the time, with the switching steps corrected
   // locally (the correction's series on the rows it reaches) and on the whole state: the same
   // switching steps and switches (up to springs grazing their kink within rounding, which may

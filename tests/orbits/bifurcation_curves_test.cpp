@@ -164,7 +164,7 @@ std::vector<Bifurcation> spring3_grazing() {
 
 TEST_CASE("grazing curves of a contact-free branch follow the closed form, and meet in a double "
           "grazing where two amplitudes are equal, dense and matrix-free",
-          "[orbits][curves]") {
+          "[orbits][curves][release-only]") {
   // Figure 4a's chain with gaps of 1: from θ = 0.8 down, spring 2 lets go at θ = 0.6817 and the
   // orbit is linear until spring 4 touches at θ = 0.6170.
   NondimensionalChain chain = paper_five_dof_case("4a");
@@ -250,7 +250,7 @@ TEST_CASE("grazing curves of a contact-free branch follow the closed form, and m
 
 TEST_CASE("period-doubling and Neimark-Sacker curves agree with one-parameter continuations at "
           "five values of the second parameter",
-          "[orbits][curves]") {
+          "[orbits][curves][release-only]") {
   const NondimensionalChain chain = paper_five_dof_case("5");  // α = 5
   struct Case {
     double from, to;
@@ -288,7 +288,7 @@ TEST_CASE("period-doubling and Neimark-Sacker curves agree with one-parameter co
 
 TEST_CASE("the hardening oscillator's two folds are one curve in (theta, amplitude), meeting in "
           "a cusp",
-          "[orbits][curves]") {
+          "[orbits][curves][release-only]") {
   // One mass, α = 3, ζ = 0.1, Δ̃ = 1.5, Q = 0.5: the resonance bends toward higher θ once the mass
   // reaches its gap, with two folds and hysteresis between them.
   const NondimensionalChain chain = pwl::test::hardening_oscillator(1.0);
@@ -431,7 +431,7 @@ TEST_CASE("strong resonances on a Neimark-Sacker curve sit where a one-parameter
 
 TEST_CASE("a matrix-free grazing curve through motion with contact agrees with one-parameter "
           "continuations, and its codimension-two points with the dense monodromy",
-          "[orbits][curves]") {
+          "[orbits][curves][release-only]") {
   // Figure 5's chain (α = 5): from θ = 1.45 up spring 3 grazes at θ = 1.4837, between two period
   // doublings. Its curve in (θ, α) meets a Neimark–Sacker curve near α = 4.74 and a
   // period-doubling curve near α = 5.41.
@@ -581,7 +581,7 @@ TEST_CASE("on a fixed-grid method that records its tangent map, the matrix-free 
 
 TEST_CASE("matrix-free period-doubling and fold curves are the dense ones, with their "
           "codimension-two points",
-          "[orbits][curves]") {
+          "[orbits][curves][release-only]") {
   // Figure 5's chain (α = 5): the period doubling at θ = 1.01 has a curve in (θ, α) that meets a
   // 1:2 resonance near α = 2.95 and a fold-flip point near α = 7.84; the hardening oscillator's two
   // folds are one curve in (θ, amplitude). Each followed dense and matrix-free (the solver forced
@@ -710,7 +710,7 @@ TEST_CASE("matrix-free period-doubling and fold curves are the dense ones, with 
 }
 
 TEST_CASE("matrix-free Neimark-Sacker curves are the dense ones, with their strong resonances",
-          "[orbits][curves]") {
+          "[orbits][curves][release-only]") {
   // The two Neimark–Sacker curves of figure 5's chain of the resonances test above: from
   // θ = 1.9118 up in α through a 1:4 resonance, from θ = 0.9920 down to the 1:2 resonance where
   // it ends. Dense and matrix-free (Newton–Krylov on two entries of the bordered test matrix of

@@ -195,7 +195,7 @@ TEST_CASE("the stroboscopic map replays a plain evaluation's tangent, not a long
 }
 
 TEST_CASE("thick-restarted Arnoldi resolves long-wave multipliers crowded against 1",
-          "[orbits]") {
+          "[orbits][release-only]") {
   // A = S D S⁻¹ of size 1000 with the spectrum of a long chain's orbit: the long-wave modes crowd
   // against μ = 1, μ_k = (1 − 4e-6 k²) e^{±0.0131 k i} for k = 1 .. 200 (the law the 1000-mass
   // chain of `pwl bench orbits` follows, where the dense monodromy's leading pairs are 0.999996,

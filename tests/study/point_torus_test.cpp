@@ -39,7 +39,7 @@ PointSettings exact_record() {
 
 }  // namespace
 
-TEST_CASE("a torus is quasi-periodic: its points stay on one smooth curve", "[sweep_point][torus]") {
+TEST_CASE("a torus is quasi-periodic: its points stay on one smooth curve", "[sweep_point][torus][release-only]") {
   const PointCase point = chain(1.8);
   pwl::test::StateRecorder recorder;
   const PointResult r = evaluate_point(point, Vector::Zero(10), exact_record(), &recorder);

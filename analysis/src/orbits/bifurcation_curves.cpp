@@ -405,8 +405,10 @@ class CurvesRunner {
         target = b.multiplier.imag() < 0 ? std::conj(b.multiplier) : b.multiplier;
       }
       Eigen::MatrixXcd ritz;
+      curves_detail::CurvePreconditioner open(maps_, k, b.parameter, q0_, 1.0);
       const FloquetMultipliers mu = curves_detail::leading_multipliers(
-          maps_, b.state, b.parameter, q0_, k, nullptr, &ritz, MatrixFreeBordered::kOnCircle);
+          maps_, b.state, b.parameter, q0_, k, open.at(b.parameter, q0_), nullptr, &ritz,
+          MatrixFreeBordered::kOnCircle);
       Index best = -1;
       for (Index i = 0; i < static_cast<Index>(mu.values.size()); ++i) {
         if (best < 0 || std::abs(mu.values[i] - target) < std::abs(mu.values[best] - target)) {

@@ -40,19 +40,35 @@ class DavidsonBasis {
   auto image() const { return W_.leftCols(columns_); }
   Matrix projected() const { return H_.topLeftCorner(columns_, columns_); }
 
-  // Adds what of each candidate column is new to the basis (orthogonalised twice; a column whose
-  // new part is below 1e-10 of it is left out), then their products, in one call of apply (the
-  // map spreads two columns over two integrators). Returns how many were added.
+  // Adds what of each candidate column is new to the basis (a column whose new part is below
+  // 1e-10 of it is left out), then their products, in one call of apply (the map spreads two
+  // columns over two integrators). Returns how many were added. The candidates are orthogonalised
+  // against the basis as one block, twice (classical Gram-Schmidt with reorthogonalisation: V is
+  // read four times a step, not four times a column), then column by column against each other.
   int add(Matrix candidates) {
     const int before = columns_;
+    std::vector<double> original(static_cast<std::size_t>(candidates.cols()));
+    for (Index c = 0; c < candidates.cols(); ++c) {
+      original[static_cast<std::size_t>(c)] = candidates.col(c).norm();
+      if (!(original[static_cast<std::size_t>(c)] > 0) ||
+          !std::isfinite(original[static_cast<std::size_t>(c)])) {
+        candidates.col(c).setZero();
+      }
+    }
+    if (before > 0) {
+      for (int pass = 0; pass < 2; ++pass) {
+        const Matrix coefficients = V_.leftCols(before).transpose() * candidates;
+        candidates.noalias() -= V_.leftCols(before) * coefficients;
+      }
+    }
     for (Index c = 0; c < candidates.cols() && columns_ < V_.cols(); ++c) {
-      const double original = candidates.col(c).norm();
-      if (!(original > 0) || !std::isfinite(original)) continue;
+      const double norm = original[static_cast<std::size_t>(c)];
+      if (!(norm > 0) || !std::isfinite(norm)) continue;
       Vector x = candidates.col(c);
-      Vector unused = Vector::Zero(columns_);
-      detail::project_out_twice(V_.leftCols(columns_), x, unused);
+      Vector unused = Vector::Zero(columns_ - before);
+      detail::project_out_twice(V_.middleCols(before, columns_ - before), x, unused);
       const double left = x.norm();
-      if (!(left > 1e-10 * original)) continue;
+      if (!(left > 1e-10 * norm)) continue;
       V_.col(columns_++) = x / left;
     }
     const int added = columns_ - before;
@@ -93,17 +109,41 @@ struct RitzPair {
   double residual = -1.0;  // not yet computed
 };
 
-// |W y − θ V y| / |V y| (V orthonormal: |V y| = |y|), from the products themselves.
-double residual_of(const DavidsonBasis& basis, const RitzPair& pair) {
-  const Vector yr = pair.coefficients.real(), yi = pair.coefficients.imag();
-  const Vector ur = basis.basis() * yr, ui = basis.basis() * yi;
-  const Vector wr = basis.image() * yr, wi = basis.image() * yi;
-  const double a = pair.value.real(), b = pair.value.imag();
-  // (wr + i wi) − (a + i b)(ur + i ui)
-  const double real_part = (wr - a * ur + b * ui).squaredNorm();
-  const double imag_part = (wi - a * ui - b * ur).squaredNorm();
-  return std::sqrt(real_part + imag_part) / pair.coefficients.norm();
-}
+// The reported pairs' Ritz vectors u = V y and their images M u = W y, all in two products of
+// the basis with one real matrix (the pairs' coefficients' real and imaginary parts side by
+// side): V and W are read once a step, not once a pair, which at 10^4 masses and a basis of
+// hundreds of columns is what a step costs besides its products.
+struct RitzVectors {
+  Matrix u, w;  // columns 2j and 2j + 1: the real and imaginary parts of pair j's V y and W y
+
+  RitzVectors(const DavidsonBasis& basis, const std::vector<RitzPair>& pairs) {
+    const Index k = basis.columns();
+    Matrix Y(k, 2 * static_cast<Index>(pairs.size()));
+    for (std::size_t j = 0; j < pairs.size(); ++j) {
+      Y.col(2 * static_cast<Index>(j)) = pairs[j].coefficients.real();
+      Y.col(2 * static_cast<Index>(j) + 1) = pairs[j].coefficients.imag();
+    }
+    u.noalias() = basis.basis() * Y;
+    w.noalias() = basis.image() * Y;
+  }
+
+  // Pair j's unit Ritz vector and its residual M u − θ u (|y| = |V y|, V orthonormal).
+  Eigen::VectorXcd vector(std::size_t j, const RitzPair& pair) const {
+    return part(u, j) / pair.coefficients.norm();
+  }
+  Eigen::VectorXcd residual(std::size_t j, const RitzPair& pair) const {
+    return (part(w, j) - pair.value * part(u, j)) / pair.coefficients.norm();
+  }
+
+ private:
+  static Eigen::VectorXcd part(const Matrix& x, std::size_t j) {
+    const Index c = 2 * static_cast<Index>(j);
+    Eigen::VectorXcd z(x.rows());
+    z.real() = x.col(c);
+    z.imag() = x.col(c + 1);
+    return z;
+  }
+};
 
 }  // namespace
 
@@ -190,8 +230,9 @@ FloquetMultipliers preconditioned_floquet_multipliers(const std::function<void(M
     const double scale = std::max(1.0, pairs.empty() ? 1.0 : std::abs(pairs.front().value));
     std::vector<std::size_t> targets;
     double worst = 0.0;
+    const RitzVectors ritz(basis, invariant ? std::vector<RitzPair>{} : pairs);
     for (std::size_t i = 0; i < pairs.size(); ++i) {
-      pairs[i].residual = invariant ? 0.0 : residual_of(basis, pairs[i]) / scale;
+      pairs[i].residual = invariant ? 0.0 : ritz.residual(i, pairs[i]).norm() / scale;
       worst = std::max(worst, pairs[i].residual);
       if (pairs[i].residual > options.tolerance && targets.size() < kTargets) targets.push_back(i);
     }
@@ -216,10 +257,8 @@ FloquetMultipliers preconditioned_floquet_multipliers(const std::function<void(M
     Index filled = 0;
     for (const std::size_t target : targets) {
       const RitzPair& pair = pairs[target];
-      const double norm = pair.coefficients.norm();
-      const Eigen::VectorXcd u = basis.basis().cast<Complex>() * pair.coefficients / norm;
-      const Eigen::VectorXcd r =
-          basis.image().cast<Complex>() * pair.coefficients / norm - pair.value * u;
+      const Eigen::VectorXcd u = ritz.vector(target, pair);
+      const Eigen::VectorXcd r = ritz.residual(target, pair);
       const Eigen::VectorXcd Kr = inverse(r, pair.value);
       const Eigen::VectorXcd Ku = inverse(u, pair.value);
       Eigen::VectorXcd t;
@@ -285,8 +324,10 @@ FloquetMultipliers preconditioned_floquet_multipliers(const std::function<void(M
   }
   vectors->resize(size, static_cast<Index>(result.values.size()));
   Index c = 0;
-  for (const RitzPair& pair : pairs) {
-    Eigen::VectorXcd x = basis.basis().cast<Complex>() * pair.coefficients;
+  const RitzVectors ritz(basis, pairs);
+  for (std::size_t j = 0; j < pairs.size(); ++j) {
+    const RitzPair& pair = pairs[j];
+    Eigen::VectorXcd x = ritz.vector(j, pair);
     x /= x.norm();
     vectors->col(c++) = x;
     if (pair.value.imag() != 0.0) vectors->col(c++) = x.conjugate();

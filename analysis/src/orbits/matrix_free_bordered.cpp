@@ -250,7 +250,8 @@ std::optional<Vector> MatrixFreeBordered::bordered_solve(const Vector& u, const 
 
 FloquetMultipliers MatrixFreeBordered::multipliers(const Vector& u, const Eigen::MatrixXcd* warm,
                                                    Eigen::MatrixXcd* ritz) {
-  return leading_multipliers(maps_, u.head(n_), p(u), q(u), period_, warm, ritz, kOnCircle);
+  return leading_multipliers(maps_, u.head(n_), p(u), q(u), period_, open_.at(p(u), q(u)), warm,
+                             ritz, kOnCircle);
 }
 
 bool MatrixFreeBordered::evaluate(const Vector& u, Vector& G, Matrix* jacobian) {

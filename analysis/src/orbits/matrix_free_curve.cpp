@@ -1,5 +1,7 @@
 #include "orbits/matrix_free_curve.hpp"
 
+#include "orbits/leading_multipliers.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -49,19 +51,20 @@ Vector MatrixFreeCurve::tangent(const Vector& u, const Vector& previous) {
 }
 
 FloquetMultipliers leading_multipliers(PlaneMaps& maps, const Vector& y, double p, double q,
-                                       int period, const Eigen::MatrixXcd* warm,
-                                       Eigen::MatrixXcd* ritz, double margin) {
+                                       int period, const detail::OpenStructurePreconditioner* open,
+                                       const Eigen::MatrixXcd* warm, Eigen::MatrixXcd* ritz,
+                                       double margin) {
   StroboscopicMap& map = maps.at(p, q);
   ArnoldiOptions arnoldi = maps.options().shooting.arnoldi;
   arnoldi.block = map.tangent_block();
   arnoldi.margin = std::max(arnoldi.margin, margin);
   CurvesResult& counts = maps.result();
-  return leading_floquet_multipliers(
+  return detail::leading_multipliers(
       [&](Matrix& v) {
         map.advance(y, period, v);
         counts.arnoldi_products += v.cols();
       },
-      y.size(), arnoldi, warm, ritz);
+      y.size(), arnoldi, open, warm, ritz);
 }
 
 CurvePreconditioner::CurvePreconditioner(PlaneMaps& maps, int period, double p0, double q0,

@@ -62,13 +62,16 @@ class MatrixFreeCurve {
 std::function<Vector(const Vector&)> monodromy_products(PlaneMaps& maps, const Vector& y, double p,
                                                         double q, int period);
 
-// The leading multipliers of the orbit through y at (p, q) by Arnoldi on its map's products
-// (counted as CurvesResult::arnoldi_products), every one with |μ| > 1 − `margin` among them (at
-// least ArnoldiOptions::margin): a curve whose condition puts a multiplier on the circle asks for
-// a margin, so that its multiplier is reported even where many others lie outside the circle.
+// The leading multipliers of the orbit through y at (p, q) on its map's products (counted as
+// CurvesResult::arnoldi_products), every one with |μ| > 1 − `margin` among them (at least
+// ArnoldiOptions::margin): a curve whose condition puts a multiplier on the circle asks for a
+// margin, so that its multiplier is reported even where many others lie outside the circle. By
+// Davidson preconditioned by `open` where that is given and available, by Arnoldi otherwise, as
+// on a one-parameter branch (orbits/leading_multipliers.hpp).
 FloquetMultipliers leading_multipliers(PlaneMaps& maps, const Vector& y, double p, double q,
-                                       int period, const Eigen::MatrixXcd* warm,
-                                       Eigen::MatrixXcd* ritz, double margin = 0.0);
+                                       int period, const detail::OpenStructurePreconditioner* open,
+                                       const Eigen::MatrixXcd* warm, Eigen::MatrixXcd* ritz,
+                                       double margin = 0.0);
 
 // The open structure's (M0 − σI)⁻¹, GMRES's preconditioner on a curve: built from the structure
 // at the curve's start (where ShootingOptions::precondition asks for it) and retimed to each

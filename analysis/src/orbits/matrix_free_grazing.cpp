@@ -141,7 +141,8 @@ std::optional<Vector> MatrixFreeGrazing::bordered_solve(const Vector& u, const V
 
 FloquetMultipliers MatrixFreeGrazing::multipliers(const Vector& u, const Eigen::MatrixXcd* warm,
                                                   Eigen::MatrixXcd* ritz) {
-  return leading_multipliers(maps_, u.head(n_), p(u), q(u), period_, warm, ritz);
+  return leading_multipliers(maps_, u.head(n_), p(u), q(u), period_, open_.at(p(u), q(u)), warm,
+                             ritz);
 }
 
 }  // namespace pwl::orbits::curves_detail
