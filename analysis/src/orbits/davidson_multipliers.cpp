@@ -47,13 +47,12 @@ class DavidsonBasis {
   // read four times a step, not four times a column), then column by column against each other.
   int add(Matrix candidates) {
     const int before = columns_;
-    std::vector<double> original(static_cast<std::size_t>(candidates.cols()));
+    const Vector original = candidates.colwise().norm().transpose();
+    const auto usable = [&original](Index c) {
+      return original(c) > 0 && std::isfinite(original(c));
+    };
     for (Index c = 0; c < candidates.cols(); ++c) {
-      original[static_cast<std::size_t>(c)] = candidates.col(c).norm();
-      if (!(original[static_cast<std::size_t>(c)] > 0) ||
-          !std::isfinite(original[static_cast<std::size_t>(c)])) {
-        candidates.col(c).setZero();
-      }
+      if (!usable(c)) candidates.col(c).setZero();
     }
     if (before > 0) {
       for (int pass = 0; pass < 2; ++pass) {
@@ -62,13 +61,12 @@ class DavidsonBasis {
       }
     }
     for (Index c = 0; c < candidates.cols() && columns_ < V_.cols(); ++c) {
-      const double norm = original[static_cast<std::size_t>(c)];
-      if (!(norm > 0) || !std::isfinite(norm)) continue;
+      if (!usable(c)) continue;
       Vector x = candidates.col(c);
       Vector unused = Vector::Zero(columns_ - before);
       detail::project_out_twice(V_.middleCols(before, columns_ - before), x, unused);
       const double left = x.norm();
-      if (!(left > 1e-10 * norm)) continue;
+      if (!(left > 1e-10 * original(c))) continue;
       V_.col(columns_++) = x / left;
     }
     const int added = columns_ - before;
@@ -273,6 +271,7 @@ FloquetMultipliers preconditioned_floquet_multipliers(const std::function<void(M
     }
     candidates.conservativeResize(Eigen::NoChange, filled);
 
+    bool restarted = false;  // then `pairs` belong to the basis before the restart
     if (basis.columns() < m && basis.columns() + candidates.cols() > m) {
       // What fits before the basis is full (all of the space, where m is its size).
       candidates.conservativeResize(Eigen::NoChange, m - basis.columns());
@@ -298,12 +297,15 @@ FloquetMultipliers preconditioned_floquet_multipliers(const std::function<void(M
       if (kept == 0) break;
       const Eigen::HouseholderQR<Matrix> qr(Z.leftCols(kept));
       basis.restrict_to(qr.householderQ() * Matrix::Identity(k, kept));
+      restarted = true;
     }
     if (basis.add(candidates) == 0) {
       // The correction lies in the basis already: a fresh random direction keeps it growing.
       Matrix fresh(size, 1);
       for (Index i = 0; i < size; ++i) fresh(i, 0) = normal(rng);
-      if (basis.add(fresh) == 0) break;
+      // Nothing new at all: stop, unless a restart just changed the basis, whose Ritz pairs the
+      // next pass forms (each such pass spends a restart, so this ends).
+      if (basis.add(fresh) == 0 && !restarted) break;
     }
   }
 
