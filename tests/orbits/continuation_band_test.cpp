@@ -3,14 +3,16 @@
 // two Neimark–Sacker points near θ = 1.9666 (that pair comes in) and 1.9884 (another pair goes
 // out), and unstable again beyond: both ends of a step from θ ≈ 1.95 to ≈ 2.0 have one complex pair
 // outside, the same signature, and the step explains nothing. With a band round the circle
-// (ArnoldiOptions::margin) continuation halves a step over which a multiplier near the circle
-// moved more than half the margin, so the window's two points are found and located, here checked
-// against a bisection on θ of the largest multiplier's modulus of orbits found by plain Newton at
-// tolerance 1e-13; dense (Newton and chord correctors) and matrix-free alike.
+// (ContinuationOptions::band; 0.05 unless set) continuation halves a step over which a multiplier
+// near the circle moved more than half the band, so the window's two points are found and located,
+// here checked against a bisection on θ of the largest multiplier's modulus of orbits found by
+// plain Newton at tolerance 1e-13; dense (Newton and chord correctors) and matrix-free alike, and
+// with the default band.
 #include <catch2/catch.hpp>
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <tuple>
 #include <vector>
 
 #include "continuation_cases.hpp"
@@ -49,7 +51,9 @@ double bisect(double a, double b, const Vector& guess) {
   return 0.5 * (a + b);
 }
 
-ContinuationOptions coarse(double margin, Corrector corrector) {
+// Matrix-free, the leading multipliers are asked to cover the band too (ArnoldiOptions::margin),
+// so that it is not narrowed to what six of them cover.
+ContinuationOptions coarse(double band, Corrector corrector, ShootingSolver solver) {
   ContinuationOptions o;
   o.parameter = analysis::SweepParameter::theta;
   o.start = kFrom;
@@ -57,7 +61,8 @@ ContinuationOptions coarse(double margin, Corrector corrector) {
   o.initial_step = 0.3;  // arclength in (y, θ): the first step reaches past θ = 2
   o.max_step = 0.1;
   o.corrector = corrector;
-  o.shooting.arnoldi.margin = margin;
+  o.band = band;
+  if (solver == ShootingSolver::krylov) o.shooting.arnoldi.margin = band;
   return o;
 }
 
@@ -79,7 +84,8 @@ TEST_CASE("a band round the unit circle finds the stable window a coarse step ju
 
   // Without a band the coarse steps see the same signature at both ends and nothing between.
   const ContinuationResult blind =
-      pwl::test::follow(chain, guess, coarse(0.0, Corrector::newton), ShootingSolver::dense);
+      pwl::test::follow(chain, guess, coarse(0.0, Corrector::newton, ShootingSolver::dense),
+                        ShootingSolver::dense);
   REQUIRE(neimark_sacker(blind).empty());
   CHECK(blind.band_cuts == 0);
 
@@ -88,15 +94,19 @@ TEST_CASE("a band round the unit circle finds the stable window a coarse step ju
   const double goes_out = bisect(1.98, 1.995, guess);
   INFO("bisection: " << comes_in << ", " << goes_out);
 
-  const double margin = 0.1;
-  for (const auto& [solver, corrector] :
-       {std::pair{ShootingSolver::dense, Corrector::newton},
-        std::pair{ShootingSolver::dense, Corrector::chord},
-        std::pair{ShootingSolver::krylov, Corrector::newton}}) {
+  // A band of 0.1 by each corrector and solver, and the default band (0.05) by Newton.
+  const double fallback = ContinuationOptions{}.band;
+  REQUIRE(fallback > 0);
+  for (const auto& [solver, corrector, band] :
+       {std::tuple{ShootingSolver::dense, Corrector::newton, 0.1},
+        std::tuple{ShootingSolver::dense, Corrector::chord, 0.1},
+        std::tuple{ShootingSolver::krylov, Corrector::newton, 0.1},
+        std::tuple{ShootingSolver::dense, Corrector::newton, fallback}}) {
     INFO((solver == ShootingSolver::dense ? "dense, " : "matrix-free, ")
-         << corrector_name(corrector));
+         << corrector_name(corrector) << ", band " << band);
     const ContinuationResult r =
-        pwl::test::follow(chain, guess, coarse(margin, corrector), solver);
+        pwl::test::follow(chain, guess, coarse(band, corrector, solver), solver);
+    CHECK(r.narrowest_band == band);  // every multiplier of the band known: never narrowed
     CHECK(r.matrix_free == (solver == ShootingSolver::krylov));
     CHECK(r.band_cuts > 0);
     const std::vector<const Bifurcation*> ns = neimark_sacker(r);

@@ -1,6 +1,6 @@
 // The band check's pairing of the multipliers near the unit circle between the two ends of a
 // continuation step (analysis/src/orbits/multiplier_movement.hpp), on sets whose answer is known
-// by hand: within half the margin or not, one to one in a crowd (where nearest neighbours alone
+// by hand: within half the margin or not, a turn at a constant modulus, one to one in a crowd (where nearest neighbours alone
 // would pass), an augmenting path where the first choice blocks the second, both ends in turn,
 // multipliers far from the circle ignored, a NaN never trusted.
 #include <catch2/catch.hpp>
@@ -37,6 +37,21 @@ TEST_CASE("the band check pairs the multipliers near the circle one to one withi
     // Complex pairs turned a little: each member pairs with its own.
     const C mu = std::polar(0.995, 0.8), nu = std::polar(1.01, 0.83);
     CHECK(stayed({mu, std::conj(mu)}, {nu, std::conj(nu)}, margin));
+  }
+  SECTION("a turn at nearly the same modulus is no movement across the band") {
+    // A long wave of a long chain: 3e-4 rad further round as the period changed, its modulus
+    // 1e-7 larger, against a band of 2e-5 (a partner within 1e-5): it stayed.
+    const C wave = std::polar(1.0 - 5e-6, 0.003), turned = std::polar(1.0 - 4.9e-6, 0.0033);
+    CHECK(stayed({wave, std::conj(wave)}, {turned, std::conj(turned)}, 2e-5));
+    // Turned by more than kBandTurn, or its modulus moved by more than half the margin: not.
+    CHECK_FALSE(stayed({wave}, {std::polar(1.0 - 5e-6, 0.003 + 0.03)}, 2e-5));
+    CHECK_FALSE(stayed({wave}, {std::polar(1.0 - 2e-5, 0.0033)}, 2e-5));
+    // One pair goes out while another comes in elsewhere on the circle: the same moduli at both
+    // ends, the same count outside, but neither pair has a partner (a stable window in between).
+    const C out_a = std::polar(1.03, 0.5), in_a = std::polar(0.96, 1.2);
+    const C in_b = std::polar(0.96, 0.5), out_b = std::polar(1.03, 1.2);
+    CHECK_FALSE(stayed({out_a, std::conj(out_a), in_a, std::conj(in_a)},
+                       {in_b, std::conj(in_b), out_b, std::conj(out_b)}, margin));
   }
   SECTION("one to one: two near the circle are not both explained by one") {
     // Nearest neighbours would pass: 0.98 and 0.99 are each within 0.01 of 0.985.

@@ -40,6 +40,10 @@ bool ContinuationOptions::is_valid(std::string* why) const {
                            locate_tolerance, why)) {
     return false;
   }
+  if (!(band >= 0 && band < 1)) {
+    *why = fmt::format("band = {} must be in [0, 1)", band);
+    return false;
+  }
   if (max_branches < 0) {
     *why = fmt::format("max branches = {} must be >= 0", max_branches);
     return false;
@@ -67,6 +71,16 @@ bool ContinuationOptions::is_valid(std::string* why) const {
 namespace {
 
 constexpr double kRealTolerance = 1e-9;  // |Im μ| below this (relative) counts as real
+
+// The band below the unit circle whose every multiplier is among those reported: all of it where
+// they are all 2n of them, else down to the smallest modulus reported (the leading ones, found by
+// modulus; with ArnoldiOptions::margin, at least that margin where the band was covered).
+double watched_band(const FloquetMultipliers& mu) {
+  if (mu.complete) return 1.0;
+  double smallest = 1.0;
+  for (const auto& m : mu.values) smallest = std::min(smallest, std::abs(m));
+  return mu.values.empty() ? 0.0 : 1.0 - smallest;
+}
 
 bool is_real(const std::complex<double>& mu) {
   return std::abs(mu.imag()) <= kRealTolerance * std::max(1.0, std::abs(mu));
@@ -151,6 +165,12 @@ constexpr Index kChordAbove = 20;
 // orbits closed to 1e-10 were off by up to 8.9e-8, and on orbits closed to 1e-12 they agreed
 // between the two correctors to 1e-9.
 constexpr double kLocateResidual = 1e-12;
+// Matrix-free, the multipliers of those trial points are asked for to this relative residual
+// (accepted at the shooting's own, ArnoldiOptions::tolerance, where they stop short of it): a
+// test function |μ| − 1 of a long chain's long wave changes by about 5e-5 per unit of θ (the
+// 1000-mass chain's first Neimark–Sacker point), so Ritz values to 1e-10 placed it only to about
+// 2e-8, from run to run.
+constexpr double kLocateMultipliers = 1e-12;
 // A real multiplier within this of +1 or -1 at both ends of a step is pinned there, not crossing.
 constexpr double kPinned = 1e-6;
 // A step whose multipliers' signature is not explained is cut in two at most this many times in
@@ -366,17 +386,23 @@ class Continuer {
   // thick-restarted Arnoldi warm-started from `warm` (a point nearby): at least the options'
   // count, and every one in the band of the options' margin (by default: every one outside the
   // unit circle).
-  void leading_multipliers(Point& pt, int period, const Eigen::MatrixXcd* warm) {
+  void leading_multipliers(Point& pt, int period, const Eigen::MatrixXcd* warm,
+                           bool locating = false) {
     StroboscopicMap& map = map_at(pt.p());
     const Vector y = pt.y();
     ArnoldiOptions arnoldi = options_.shooting.arnoldi;
     arnoldi.block = map.tangent_block();
+    if (locating) arnoldi.tolerance = std::min(arnoldi.tolerance, kLocateMultipliers);
     pt.mu = detail::leading_multipliers(
         [&](Matrix& v) {
           map.advance(y, period, v);
           result_.arnoldi_products += v.cols();
         },
         y.size(), arnoldi, open_at(pt.p(), period), warm, &pt.ritz);
+    if (locating && !pt.mu.converged && pt.mu.residual <= options_.shooting.arnoldi.tolerance) {
+      pt.mu.converged = true;  // as it would have been asked for the shooting's tolerance
+      pt.mu.band_covered = pt.mu.complete || 1.0 - watched_band(pt.mu) <= 1.0 - arnoldi.margin;
+    }
     if (!pt.mu.converged) ++result_.unconverged_multipliers;
     if (pt.mu.converged && !pt.mu.band_covered) ++result_.uncovered_bands;
   }
@@ -428,7 +454,9 @@ class Continuer {
       best->iterations = c->iterations;
     }
     if (!best) return std::nullopt;
-    if (multipliers) leading_multipliers(*best, period, near != nullptr ? &near->ritz : nullptr);
+    if (multipliers) {
+      leading_multipliers(*best, period, near != nullptr ? &near->ritz : nullptr, polish > 0);
+    }
     return best;
   }
 
@@ -529,25 +557,29 @@ class Continuer {
       return std::nullopt;
     }
 
-    // With a band (ArnoldiOptions::margin > 0): a step is cut when a multiplier within half the
-    // margin of the circle at one end has no partner of its own within half the margin of it at
-    // the other (detail::band_stayed). What it catches: a multiplier near the circle that goes
+    // With a band (ContinuationOptions::band > 0, or ArnoldiOptions::margin where wider): a step
+    // is cut when a multiplier within half the band of the circle at one end has no partner of
+    // its own at the other (detail::band_stayed: within half the band in the plane, or in modulus
+    // having turned by at most 0.02 rad). What it catches: a multiplier near the circle that goes
     // out and back (or in and out) within one step, the same signature at both ends, as long as
-    // its path over the step is not bent by more than its distance from the circle at the ends
-    // (the disc is convex: a multiplier that moves straight between two points inside stays
-    // inside; outside, the same holds while the step is short against the circle's curvature).
-    // What it does not: a multiplier farther than half the margin from the circle at both ends
-    // (two pairs that cross the circle in opposite directions within one step from outside the
-    // margin leave the signature as it was: a margin above the multipliers' movement in a step is
-    // the user's choice), and a step already at four times the smallest (the core stops cutting
-    // there). Not where either end's band is not covered or its multipliers did not converge.
+    // its modulus over the step does not swing by more than its distance from the circle at the
+    // ends. What it does not: a multiplier farther than half the band from the circle at both
+    // ends (two pairs that cross the circle in opposite directions within one step from outside
+    // the band leave the signature as it was: a band wider than the multipliers' movement in a
+    // step is the user's choice), and a step already at four times the smallest (the core stops
+    // cutting there). Where only the leading multipliers are known, the band is narrowed to what
+    // both ends cover (watched_band), so that a near multiplier's partner, if it moved less than
+    // half the band, is among the other end's; not checked where either end did not converge.
     bool too_long(const Point& from, const Point& to) override {
-      const double margin = c_.options_.shooting.arnoldi.margin;
-      if (!(margin > 0)) return false;
+      double band = std::max(c_.options_.band, c_.options_.shooting.arnoldi.margin);
+      if (!(band > 0)) return false;
       for (const Point* end : {&from, &to}) {
-        if (!end->mu.converged || !end->mu.band_covered) return false;
+        if (!end->mu.converged) return false;
+        band = std::min(band, watched_band(end->mu));
       }
-      if (detail::band_stayed(from.mu.values, to.mu.values, margin)) return false;
+      if (!(band > 0)) return false;
+      c_.result_.narrowest_band = std::min(c_.result_.narrowest_band, band);
+      if (detail::band_stayed(from.mu.values, to.mu.values, band)) return false;
       ++c_.result_.band_cuts;
       return true;
     }

@@ -448,10 +448,17 @@ void continue_orbit(const ContinueFlags& f) {
                "the multipliers' signature\n",
                result.monodromies, result.integrations, result.step_cuts);
   }
-  if (result.band_cuts > 0) {
-    fmt::print("  {} step(s) halved where a multiplier within {:.6g} of the circle had no partner "
-               "that near it at the step's other end\n",
-               result.band_cuts, 0.5 * c.shooting.arnoldi.margin);
+  if (std::isfinite(result.narrowest_band)) {
+    const double asked = std::max(c.band, c.shooting.arnoldi.margin);
+    fmt::print("band: steps checked for a multiplier within half of {:.6g} of the circle "
+               "without a partner at its other end{}; {} step(s) halved\n",
+               asked,
+               result.narrowest_band < asked
+                   ? fmt::format(" (narrowed to {:.3g} where only the leading multipliers were "
+                                 "known)",
+                                 result.narrowest_band)
+                   : "",
+               result.band_cuts);
   }
   fmt::print("time: {:.2f} s ({} points)\n", seconds, outputs.points());
   fmt::print("wrote {0}/branch.csv, {0}/branch_section.csv and {0}/bifurcations.csv\n", o.out);
@@ -566,6 +573,10 @@ ContinuationProblem continuation_problem(const ContinueFlags& f) {
   c.max_step = f.max_step;
   c.max_points = f.max_points;
   c.grazing = !f.no_grazing;
+  if (!(f.band >= 0 && f.band < 1)) {  // flags filled in by a caller, not parsed
+    throw InputError(fmt::format("--band = {} must be in [0, 1)", f.band));
+  }
+  c.band = f.band;
   c.corrector = orbits::parse_corrector(f.corrector);
   c.switch_branches = f.switch_branches;
   c.max_branches = f.max_branches;
@@ -709,6 +720,13 @@ void add_continue_flags(CLI::App& command, ContinueFlags& flags) {
                      "the figures draw the last one. Default: every mass up to 10, else the last")
       ->delimiter(',');
   command.add_flag("--no-grazing", flags.no_grazing, "Do not look for grazing bifurcations");
+  command.add_option("--band", flags.band,
+                     "Band round the unit circle watched between points: a step is halved while a\n"
+                     "multiplier within half of it of the circle has no partner at its other end,\n"
+                     "so that none goes out and back within a step unseen; matrix-free, narrowed\n"
+                     "to what the leading multipliers cover (--multiplier-margin widens it). 0: off")
+      ->default_val(0.05)
+      ->check(number_check({0.0, 1.0, false, true, "a number in [0, 1)"}, "[0,1)"));
   command.add_option("--corrector", flags.corrector,
                      "chord (Newton steps on the monodromy of the point predicted from, formed\n"
                      "again only where they stop contracting), newton (the monodromy at every\n"

@@ -28,6 +28,7 @@ struct ContinueFlags {
   double max_step = 0.0;
   std::vector<std::string> record;
   bool no_grazing = false;
+  double band = 0.05;  // ContinuationOptions::band
   std::string corrector = "automatic";
   int over_sweep = 0;
   int over_periods = 100;

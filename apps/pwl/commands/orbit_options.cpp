@@ -65,9 +65,7 @@ void add_orbit_flags(CLI::App& c, OrbitFlags& f, bool with_dt) {
   c.add_option("--multiplier-margin", f.multiplier_margin,
                "Krylov: Arnoldi reports every Floquet multiplier of modulus above 1 − this\n"
                "(its count doubles until the smallest is below); 0: those outside the circle.\n"
-               "continue: a step is halved while a multiplier within half this of the circle has\n"
-               "no partner within half this at the step's other end (one to one), so that one\n"
-               "moving less than that in a step does not leave the circle and come back unseen")
+               "continue: the leading multipliers cover at least this of --band's band")
       ->check(number_check({0.0, 1.0, false, true, "a number in [0, 1)"}, "[0,1)"));
   c.add_option("--multiplier-method", f.multiplier_method,
                "Krylov: automatic (Davidson preconditioned by the open structure where its damping\n"

@@ -6,6 +6,7 @@
 
 #include "pwl/errors.hpp"
 #include "pwl/numerics/state_checks.hpp"
+#include "integrators/fixed_sizes.hpp"
 #include "integrators/fixed_step_count.hpp"
 #include "pwl/integrators/precise_propagator.hpp"
 
@@ -93,7 +94,8 @@ class PimIntegrator final : public Integrator {
   IntegratorStats stats_;
 };
 
-// Fixed-size fast paths for the small square cases (one gap spring per mass).
+// Fixed-size fast paths for the small square cases (one gap spring per mass), up to
+// detail::kFixedSizes masses (integrators/fixed_sizes.hpp).
 template <int N>
 std::unique_ptr<Integrator> make_fixed(const PimStepOperators& ops, const PimOptions& options) {
   if constexpr (N > 0) {
@@ -113,7 +115,7 @@ std::unique_ptr<Integrator> make_pim_integrator(const GapStructure& structure,
   std::string why;
   if (!options.is_valid(&why)) throw InputError("pim options: " + why);
   const PimStepOperators ops = make_pim_step_operators(structure, options.step, options.exponential);
-  return make_fixed<6>(ops, options);
+  return make_fixed<detail::kFixedSizes>(ops, options);
 }
 
 }  // namespace pwl

@@ -16,6 +16,7 @@
 #include "switching/switching_pim_detail.hpp"
 #include "pwl/errors.hpp"
 #include "pwl/integrators/step_guard.hpp"
+#include "integrators/fixed_sizes.hpp"
 #include "integrators/fixed_step_count.hpp"
 #include "pwl/numerics/block_pivoting.hpp"
 #include "pwl/numerics/lcp_solver.hpp"
@@ -911,6 +912,8 @@ class Stepper final
   Force t_force_, t_force_sum_, t_force_dz_;
 };
 
+// Fixed-size steppers for the square cases of up to detail::kFixedSizes masses
+// (integrators/fixed_sizes.hpp), the dynamic one otherwise.
 template <int N>
 std::unique_ptr<SwitchingPim> make_fixed(const Operators& ops, const SwitchingPimOptions& o) {
   if constexpr (N > 0) {
@@ -936,7 +939,7 @@ std::unique_ptr<SwitchingPim> make_switching_pim(const GapStructure& structure,
                                  structure.load_groups().size()));
   }
   const Operators ops = make_operators(structure, options);
-  return make_fixed<6>(ops, options);
+  return make_fixed<detail::kFixedSizes>(ops, options);
 }
 
 }  // namespace pwl

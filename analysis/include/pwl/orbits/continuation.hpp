@@ -73,13 +73,17 @@
 // determinant's does. Branch switching takes the Ritz vector of the multiplier −1. The chord
 // corrector is dense only.
 //
-// A band round the circle (ShootingOptions::arnoldi.margin > 0, dense or matrix-free): a step is
-// halved while a multiplier within half the margin of the circle at one end has no partner of its
-// own (one to one) within half the margin of it at the other, so that a multiplier does not leave
-// the circle and come back (a window of stability or instability shorter than a step, the same
-// signature at both ends) between two points unseen; BranchWalk::too_long in continuation.cpp
-// says what this rests on and what it does not catch.
+// A band round the circle (ContinuationOptions::band, 0.05 unless set; dense or matrix-free): a
+// step is halved while a multiplier within half the band of the circle at one end has no partner
+// of its own (one to one) at the other, within half the band of it in the plane or in modulus
+// (having turned by at most 0.02 rad), so that a multiplier does not leave the circle and come
+// back (a window of stability or instability shorter than a step, the same signature at both
+// ends) between two points unseen. Matrix-free, the band is narrowed to the moduli the leading
+// multipliers cover at both ends (ShootingOptions::arnoldi.margin asks for more of them, to cover
+// a wider one); BranchWalk::too_long in continuation.cpp says what this rests on and what it does
+// not catch.
 #include <complex>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -147,6 +151,16 @@ struct ContinuationOptions {
   bool switch_branches = false;     // follow the period-2k branch at each period doubling
   int max_branches = 4;             // branches switched onto, in all
   int profile_samples = 256;        // per period, methods off a fixed grid
+  // The band round the unit circle watched between two points, so that a multiplier that goes
+  // out and comes back within one step (a stable or unstable window shorter than the step: the
+  // same counts outside at both ends) is not missed. A step is halved while a multiplier within
+  // half the band of the circle at one end has no partner at the other: within half the band of
+  // it in the plane, or in modulus having turned by at most 0.02 rad (see the head of this file).
+  // Where only the leading multipliers are known (matrix-free), the band is narrowed to what they
+  // cover at both ends: 1 − the smallest modulus reported (ShootingOptions::arnoldi: its count,
+  // and its margin, which asks for more of them). 0: no band; steps are then explained by the
+  // counts at their ends alone.
+  double band = 0.05;
   // The method that integrates the map, and its steps per forcing period (fixed grid).
   MethodSettings method{Method::exact};
   int steps_per_period = 200;
@@ -188,10 +202,12 @@ struct ContinuationResult {
   // ArnoldiOptions::margin within half Arnoldi's basis (more may lie in it, outside the circle
   // with margin 0, than were reported).
   long uncovered_bands = 0;
-  // Steps halved because a multiplier within half the band's margin of the unit circle at one end
-  // had no partner of its own within half the margin at the other (ArnoldiOptions::margin > 0
-  // only; see the head of this file).
+  // Steps halved because a multiplier within half the band of the unit circle at one end had no
+  // partner of its own at the other (ContinuationOptions::band; see the head of this file), and
+  // the narrowest band a step was checked in (narrower than asked where only the leading
+  // multipliers were known; infinity: no step was checked).
   long band_cuts = 0;
+  double narrowest_band = std::numeric_limits<double>::infinity();
   // Steps cut in two because the multipliers' signature changed in a way the events located in
   // them did not explain (several events in one step).
   long step_cuts = 0;
