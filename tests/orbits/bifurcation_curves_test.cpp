@@ -493,12 +493,14 @@ TEST_CASE("a matrix-free grazing curve through motion with contact agrees with o
   // noise like √(1e-16) times the contact's weight. Measured at the dense curve's point: |μ + 1| =
   // 2.7e-8 as it is, 3.8e-7 with the gaps 1e-14 wider (free), 2.5e-6 with them 1e-14 narrower.
   // The truth here is the dense monodromy at each curve's own point: both at −1 to 1e-6 (measured
-  // 2026-12-02: the matrix-free point 8.9e-10, the dense one 3.1e-15). The two points' α agree
-  // only to that noise over the multiplier's speed along the curve, about 1.85 per unit of α
-  // (the dense monodromy at the dense curve's rows either side, α = 5.3988 and 5.4386: μ = −0.9710
-  // and −1.0447): 2.5e-6 / 1.85 = 1.4e-6 for each point, so up to about 3e-6 apart. Measured:
-  // 1.8e-7 (2026-12-01) and 3.1e-6 (2026-12-02, the branch's grazing it starts from located
-  // after the band's extra points, the same to 1e-10); bound 1e-5. In θ, 3.6e-9 and 6.2e-8.
+  // 2026-12-02: the matrix-free point 8.9e-10; the dense one 3.1e-15, its own defining equation).
+  // The two points' α agree only to that noise over the multiplier's speed along the curve: about
+  // 1.85 per unit of α (the dense monodromy at the dense curve's rows either side, α = 5.3988 and
+  // 5.4386: μ = −0.9710 and −1.0447), not the 0.03 this comment said before 2026-12-02. The noise
+  // of a 1e-14 shift (2.5e-6) is one sample, not a bound: it alone places each point to 1.4e-6.
+  // Measured: 1.8e-7 (2026-12-01) and 3.1e-6 (2026-12-02, the branch's grazing the curve starts
+  // from located after the band's extra points, the same to 1e-10); the bound, 1e-5, is about
+  // three times the larger. In θ, 3.6e-9 and 6.2e-8.
   const Codim2Point* pd = codim2_of(r, "period-doubling-grazing");
   const Codim2Point* pd_dense = codim2_of(dense, "period-doubling-grazing");
   REQUIRE(pd != nullptr);

@@ -88,6 +88,7 @@ TEST_CASE("a band round the unit circle finds the stable window a coarse step ju
                         ShootingSolver::dense);
   REQUIRE(neimark_sacker(blind).empty());
   CHECK(blind.band_cuts == 0);
+  CHECK(std::isinf(blind.narrowest_band));  // no step checked
 
   // The two points, independently.
   const double comes_in = bisect(1.96, 1.975, guess);

@@ -1,8 +1,9 @@
 // The band check's pairing of the multipliers near the unit circle between the two ends of a
 // continuation step (analysis/src/orbits/multiplier_movement.hpp), on sets whose answer is known
-// by hand: within half the margin or not, a turn at a constant modulus, one to one in a crowd (where nearest neighbours alone
-// would pass), an augmenting path where the first choice blocks the second, both ends in turn,
-// multipliers far from the circle ignored, a NaN never trusted.
+// by hand: within half the margin or not, a turn at a constant modulus, one to one in a crowd
+// (where nearest neighbours alone would pass), an augmenting path where the first choice blocks
+// the second, both ends in turn, multipliers far from the circle ignored, a NaN never trusted;
+// and the band the reported multipliers cover (watched_band).
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <complex>
@@ -11,7 +12,9 @@
 
 #include "orbits/multiplier_movement.hpp"
 
+using pwl::orbits::FloquetMultipliers;
 using pwl::orbits::detail::band_stayed;
+using pwl::orbits::detail::watched_band;
 using C = std::complex<double>;
 using Set = std::vector<C>;
 
@@ -81,5 +84,25 @@ TEST_CASE("the band check pairs the multipliers near the circle one to one withi
     CHECK(stayed({}, {}, margin));
     CHECK(stayed({C(0.2, 0)}, {}, margin));
     CHECK_FALSE(stayed({C(1.0, 0)}, {}, margin));
+  }
+}
+
+TEST_CASE("the band the reported multipliers cover reaches down to the smallest of them",
+          "[orbits]") {
+  FloquetMultipliers mu;
+  mu.complete = false;
+  SECTION("the leading ones: down to the smallest modulus, in any order") {
+    mu.values = {C(1.2, 0), std::polar(0.97, 0.4), std::polar(0.97, -0.4), C(-0.99, 0)};
+    CHECK(watched_band(mu) == Approx(0.03).epsilon(1e-12));
+  }
+  SECTION("every multiplier of the structure: the whole band") {
+    mu.values = {C(0.5, 0), C(0.2, 0)};
+    mu.complete = true;
+    CHECK(watched_band(mu) == 1.0);
+  }
+  SECTION("none reported, or all of them outside the circle: no band to check") {
+    CHECK(watched_band(mu) == 0.0);
+    mu.values = {C(1.3, 0), C(1.1, 0)};
+    CHECK(watched_band(mu) < 0.0);
   }
 }

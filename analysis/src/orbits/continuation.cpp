@@ -72,16 +72,6 @@ namespace {
 
 constexpr double kRealTolerance = 1e-9;  // |Im μ| below this (relative) counts as real
 
-// The band below the unit circle whose every multiplier is among those reported: all of it where
-// they are all 2n of them, else down to the smallest modulus reported (the leading ones, found by
-// modulus; with ArnoldiOptions::margin, at least that margin where the band was covered).
-double watched_band(const FloquetMultipliers& mu) {
-  if (mu.complete) return 1.0;
-  double smallest = 1.0;
-  for (const auto& m : mu.values) smallest = std::min(smallest, std::abs(m));
-  return mu.values.empty() ? 0.0 : 1.0 - smallest;
-}
-
 bool is_real(const std::complex<double>& mu) {
   return std::abs(mu.imag()) <= kRealTolerance * std::max(1.0, std::abs(mu));
 }
@@ -382,26 +372,37 @@ class Continuer {
         open, b, c, d);
   }
 
-  // Matrix-free: the leading multipliers of the orbit at pt and their Ritz vectors, by
-  // thick-restarted Arnoldi warm-started from `warm` (a point nearby): at least the options'
+  // Matrix-free: the leading multipliers of the orbit at pt and their Ritz vectors, by Davidson
+  // or thick-restarted Arnoldi warm-started from `warm` (a point nearby): at least the options'
   // count, and every one in the band of the options' margin (by default: every one outside the
-  // unit circle).
+  // unit circle). `locating` (a bifurcation's trial point): asked for to kLocateMultipliers,
+  // accepted at the options' tolerance where they stop short of it; where they stop short with
+  // their band not covered (the count doubles only once converged), asked again at the options'
+  // tolerance from the Ritz vectors just found, so that the band is covered as at any point.
   void leading_multipliers(Point& pt, int period, const Eigen::MatrixXcd* warm,
                            bool locating = false) {
     StroboscopicMap& map = map_at(pt.p());
     const Vector y = pt.y();
     ArnoldiOptions arnoldi = options_.shooting.arnoldi;
     arnoldi.block = map.tangent_block();
+    const auto product = [&](Matrix& v) {
+      map.advance(y, period, v);
+      result_.arnoldi_products += v.cols();
+    };
+    const detail::OpenStructurePreconditioner* open = open_at(pt.p(), period);
     if (locating) arnoldi.tolerance = std::min(arnoldi.tolerance, kLocateMultipliers);
-    pt.mu = detail::leading_multipliers(
-        [&](Matrix& v) {
-          map.advance(y, period, v);
-          result_.arnoldi_products += v.cols();
-        },
-        y.size(), arnoldi, open_at(pt.p(), period), warm, &pt.ritz);
-    if (locating && !pt.mu.converged && pt.mu.residual <= options_.shooting.arnoldi.tolerance) {
-      pt.mu.converged = true;  // as it would have been asked for the shooting's tolerance
-      pt.mu.band_covered = pt.mu.complete || 1.0 - watched_band(pt.mu) <= 1.0 - arnoldi.margin;
+    pt.mu = detail::leading_multipliers(product, y.size(), arnoldi, open, warm, &pt.ritz);
+    const double tolerance = options_.shooting.arnoldi.tolerance;
+    if (locating && !pt.mu.converged && pt.mu.residual <= tolerance) {
+      const double smallest = 1.0 - detail::watched_band(pt.mu);
+      if (pt.mu.complete || smallest <= 1.0 - arnoldi.margin) {
+        pt.mu.converged = true;  // as asked for at the options' tolerance
+        pt.mu.band_covered = true;
+      } else {
+        const Eigen::MatrixXcd found = pt.ritz;
+        arnoldi.tolerance = tolerance;
+        pt.mu = detail::leading_multipliers(product, y.size(), arnoldi, open, &found, &pt.ritz);
+      }
     }
     if (!pt.mu.converged) ++result_.unconverged_multipliers;
     if (pt.mu.converged && !pt.mu.band_covered) ++result_.uncovered_bands;
@@ -557,7 +558,7 @@ class Continuer {
       return std::nullopt;
     }
 
-    // With a band (ContinuationOptions::band > 0, or ArnoldiOptions::margin where wider): a step
+    // With a band (ContinuationOptions::band > 0, widened to ArnoldiOptions::margin): a step
     // is cut when a multiplier within half the band of the circle at one end has no partner of
     // its own at the other (detail::band_stayed: within half the band in the plane, or in modulus
     // having turned by at most 0.02 rad). What it catches: a multiplier near the circle that goes
@@ -571,11 +572,11 @@ class Continuer {
     // both ends cover (watched_band), so that a near multiplier's partner, if it moved less than
     // half the band, is among the other end's; not checked where either end did not converge.
     bool too_long(const Point& from, const Point& to) override {
+      if (!(c_.options_.band > 0)) return false;
       double band = std::max(c_.options_.band, c_.options_.shooting.arnoldi.margin);
-      if (!(band > 0)) return false;
       for (const Point* end : {&from, &to}) {
         if (!end->mu.converged) return false;
-        band = std::min(band, watched_band(end->mu));
+        band = std::min(band, detail::watched_band(end->mu));
       }
       if (!(band > 0)) return false;
       c_.result_.narrowest_band = std::min(c_.result_.narrowest_band, band);

@@ -1,7 +1,8 @@
 #pragma once
 // Whether the Floquet multipliers near the unit circle moved less than half the band's margin
 // between the two ends of a continuation step, for the band check of continuation.cpp
-// (ContinuationOptions::band). Private to the orbits room.
+// (ContinuationOptions::band), and the band the reported multipliers cover. Private to the orbits
+// room.
 //
 // Each multiplier within half the margin of the circle at one end (||μ| − 1| <= margin / 2) must
 // have a partner of its own at the other end, one to one: a matching of those multipliers into
@@ -21,13 +22,29 @@
 // on the circle (a stable window inside one step) still finds no partner. A multiplier that
 // moved less than half the margin in modulus is, at the other end, within the band
 // |μ| > 1 − margin whose every multiplier the caller passes, so its partner is there to be found.
+#include <algorithm>
 #include <cmath>
 #include <complex>
+#include <cstddef>
 #include <functional>
 #include <utility>
 #include <vector>
 
+#include "pwl/orbits/floquet_multipliers.hpp"
+
 namespace pwl::orbits::detail {
+
+// The band below the unit circle whose every multiplier is among those reported, which the band
+// check is narrowed to: all of it (1) where they are all 2n of them, else down to the smallest
+// modulus reported (the leading ones, found by modulus; with ArnoldiOptions::margin, at least that
+// margin where the band was covered); 0 with none, negative with all of them outside the circle.
+inline double watched_band(const FloquetMultipliers& mu) {
+  if (mu.complete) return 1.0;
+  if (mu.values.empty()) return 0.0;
+  double smallest = std::abs(mu.values.front());
+  for (const auto& m : mu.values) smallest = std::min(smallest, std::abs(m));
+  return 1.0 - smallest;
+}
 
 // The turn a partner may have made at nearly the same modulus (radians, about 1.1 degrees).
 inline constexpr double kBandTurn = 0.02;

@@ -5,8 +5,8 @@
 // the same template. Each fixed size is a whole instantiation of the stepper, the heaviest code
 // the library compiles: the build option PWL_FIXED_SIZES (top-level CMakeLists.txt) sets the
 // count, 6 by default. The sanitizer build takes 2: the template's code still runs there at fixed
-// sizes (1 and 2) and at the dynamic size, in a third of the compiler time (apps/README.md, "How
-// the build is kept short"). Private to pwl_core.
+// sizes (1 and 2) and at the dynamic size (the compiler time it saves: apps/README.md, "How the
+// build is kept short"). Private to pwl_core.
 #ifndef PWL_FIXED_SIZES
 #define PWL_FIXED_SIZES 6
 #endif
