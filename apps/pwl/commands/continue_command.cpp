@@ -573,10 +573,7 @@ ContinuationProblem continuation_problem(const ContinueFlags& f) {
   c.max_step = f.max_step;
   c.max_points = f.max_points;
   c.grazing = !f.no_grazing;
-  if (!(f.band >= 0 && f.band < 1)) {  // flags filled in by a caller, not parsed
-    throw InputError(fmt::format("--band = {} must be in [0, 1)", f.band));
-  }
-  c.band = f.band;
+  c.band = f.band;  // checked by its flag, and by c.is_valid below for flags not parsed
   c.corrector = orbits::parse_corrector(f.corrector);
   c.switch_branches = f.switch_branches;
   c.max_branches = f.max_branches;
