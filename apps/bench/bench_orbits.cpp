@@ -505,13 +505,16 @@ ContinuationRow run_continuation(const ContinuationCase& c, const OrbitBenchOpti
   std::vector<double> times, cpus, colds, warms;
   for (int r = 0; r < o.repeats; ++r) {
     if (2 * static_cast<Index>(c.chain.masses) > options.shooting.dense_state_limit) {
-      // The cold orbit the warm points are measured against, as `pwl orbit` finds it.
+      // The cold orbit the warm points are measured against, as `pwl orbit` finds it: with
+      // ShootingOptions' own multiplier margin (0), not the one continuation asks for its band.
       say(fmt::format("{}, n = {}: a cold orbit at θ = {}, run {} of {} ...", c.label,
                       c.chain.masses, c.chain.theta, r + 1, o.repeats));
       orbits::StroboscopicMap map(model.point_case(), options.method, options.steps_per_period);
+      orbits::ShootingOptions as_orbit = options.shooting;
+      as_orbit.arnoldi.margin = orbits::ShootingOptions{}.arnoldi.margin;
       const Stopwatch cold;
       try {
-        orbits::find_periodic_orbit(map, guess, options.shooting);
+        orbits::find_periodic_orbit(map, guess, as_orbit);
       } catch (const Error& e) {
         row.failure = std::string("cold orbit: ") + e.what();
         break;

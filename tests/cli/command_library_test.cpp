@@ -1,7 +1,8 @@
 // The jobs as a library (simulate_command.hpp, analyze_command.hpp, sweep_command.hpp,
 // map_command.hpp), as an embedding calls them: the flags parsed by the jobs' own registration,
 // the runs in memory. --x0/--v0 against the closed-form free vibration of a damped oscillator,
-// --phase against the times it names, and the checks of bad values with the flag and value named.
+// --phase against the times it names, and the checks of bad values with the flag and value named;
+// continue_command.hpp's multiplier margin, the branch's and the curves'.
 #include <CLI/CLI.hpp>
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -9,6 +10,7 @@
 #include <vector>
 
 #include "commands/analyze_command.hpp"
+#include "commands/continue_command.hpp"
 #include "commands/map_command.hpp"
 #include "commands/simulate_command.hpp"
 #include "commands/sweep_command.hpp"
@@ -212,4 +214,37 @@ TEST_CASE("Sweeps and maps take the section and the initial state, and say them"
   parse(add_map_flags, refused, "--figure 4a --section v3=0,down");
   CHECK_THROWS_WITH(map_options(refused),
                     Contains("--section v3=0,down: a regime map keeps no Poincaré points"));
+}
+
+TEST_CASE("pwl continue asks its branch for continuation's multiplier margin, its curves for theirs",
+          "[commands]") {
+  const auto problem = [](const std::string& line) {
+    ContinueFlags flags;
+    CLI::App app;
+    add_continue_flags(app, flags);
+    app.parse(line, false);
+    read_method_given(app, flags.orbit);
+    return continuation_problem(flags);
+  };
+  const std::string branch = "--figure 5 --parameter theta --range 1.5:1.6";
+  const double curves_default = orbits::CurvesOptions{}.shooting.arnoldi.margin;
+  REQUIRE(orbits::kContinuationMargin != curves_default);
+
+  // Unparsed flags carry the same default as parsed ones.
+  CHECK(ContinueFlags{}.orbit.multiplier_margin == orbits::kContinuationMargin);
+  CHECK(orbits::ContinuationOptions{}.shooting.arnoldi.margin == orbits::kContinuationMargin);
+
+  const ContinuationProblem plain = problem(branch + " --curves alpha=4:6");
+  CHECK(plain.options.shooting.arnoldi.margin == orbits::kContinuationMargin);
+  REQUIRE(plain.curves.has_value());
+  CHECK(plain.curves->shooting.arnoldi.margin == curves_default);
+
+  const ContinuationProblem given = problem(branch + " --curves alpha=4:6 --multiplier-margin 0.002");
+  CHECK(given.options.shooting.arnoldi.margin == 0.002);
+  REQUIRE(given.curves.has_value());
+  CHECK(given.curves->shooting.arnoldi.margin == 0.002);
+
+  const ContinuationProblem zero = problem(branch + " --multiplier-margin 0");
+  CHECK(zero.options.shooting.arnoldi.margin == 0.0);
+  CHECK_FALSE(zero.curves.has_value());
 }

@@ -2,12 +2,16 @@
 // banded switching PIM's recorded tangent replayed for every GMRES and Arnoldi product), checked
 // at a point of its branch against two independent truths:
 //  - the leading multipliers against the eigenvalues of the 2000 x 2000 monodromy formed there
-//    from all 2n tangent columns, to 1e-8;
+//    from all 2n tangent columns, to 1e-8, and every eigenvalue of modulus above 1 − 1e-4 among
+//    them (a margin asked of the leading multipliers, so that the band watched between two
+//    points is not narrowed below it: about ten of the long waves' crowd lie there, more than the
+//    six a count alone would bring);
 //  - the orbit against another integrator: dopri5 at a tolerance of 1e-11 with every spring
 //    switch located (the vector field's kinks) carries the orbit's state once round the forcing
 //    period back to itself to 1e-7.
-// (Release build only: about a minute there, most of it the dense eigenvalues.)
+// (Release build only: about 40 s there, most of it the dense eigenvalues.)
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <vector>
@@ -31,6 +35,11 @@ TEST_CASE("the 1000-mass chain's branch: multipliers and closure against indepen
   o.method = method;
   o.steps_per_period = 200;
   o.max_points = 4;
+  // Wider than continuation's default margin (1e-5), whose band here holds only the longest
+  // wave's pair (|μ_k| ≈ 1 − 4e-6 k²), which six leading multipliers hold anyway.
+  const double margin = 1e-4;
+  REQUIRE(margin > kContinuationMargin);
+  o.shooting.arnoldi.margin = margin;
   const ContinuationResult r =
       continue_periodic_orbit(analysis::PointModel(chain), guess, o);
   REQUIRE(r.matrix_free);
@@ -54,6 +63,20 @@ TEST_CASE("the 1000-mass chain's branch: multipliers and closure against indepen
   measured("1000 masses: leading multipliers against the monodromy's eigenvalues", distance);
   CHECK(distance <= 1e-8);
   CHECK(all.unstable_count() == p.orbit.multipliers.unstable_count());
+
+  // The margin: every eigenvalue in the band |μ| > 1 − 1e-4 is among the reported, and the band
+  // watched between the points was never narrowed below it.
+  CHECK(p.orbit.multipliers.band_covered);
+  CHECK(r.uncovered_bands == 0);
+  std::size_t in_band = 0;
+  const double band = pwl::test::farthest_in_band(all.values, leading, margin, &in_band);
+  measured("1000 masses: eigenvalues in the band |mu| > 1 - 1e-4", static_cast<double>(in_band));
+  measured("1000 masses: farthest of them from a reported multiplier", band);
+  CHECK(in_band > 6);  // more than the default count: the margin, not the count, brought them
+  CHECK(leading.size() >= in_band);
+  CHECK(band <= 1e-8);
+  REQUIRE(std::isfinite(r.narrowest_band));  // steps were checked
+  CHECK(r.narrowest_band >= margin);
 
   // The orbit closes under kink-located dopri5 at 1e-11.
   MethodSettings reference{Method::dopri5};

@@ -6,6 +6,7 @@
 // the eigenvalues of the monodromy formed there, every one of them in the band |μ| > 0.99 among
 // the reported (ArnoldiOptions::margin). (Release build only: 43 s there.)
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <vector>
@@ -43,6 +44,11 @@ TEST_CASE("the 150-mass chain's branch is the same matrix-free as dense", "[orbi
   CHECK(free.krylov_products > 0);
   CHECK(free.arnoldi_products > 0);
   CHECK(free.unconverged_multipliers == 0);
+  // Every point covered the margin, so the band watched between points was never narrowed below
+  // it (only the leading multipliers are known matrix-free; dense, all of them).
+  CHECK(free.uncovered_bands == 0);
+  CHECK(free.narrowest_band >= margin);
+  CHECK(dense.narrowest_band == std::max(o.band, margin));
 
   // The same bifurcations in the same order, each within 1e-8 in θ.
   int neimark_sacker = 0;
@@ -103,13 +109,7 @@ TEST_CASE("the 150-mass chain's branch is the same matrix-free as dense", "[orbi
     distance = std::max(distance, pwl::test::set_distance(expected, leading));
     CHECK(p.orbit.multipliers.band_covered);
     std::size_t in_band = 0;
-    for (const std::complex<double>& mu : all.values) {
-      if (std::abs(mu) <= 1.0 - margin) continue;
-      ++in_band;
-      double nearest = 1.0;
-      for (const std::complex<double>& f : leading) nearest = std::min(nearest, std::abs(f - mu));
-      band = std::max(band, nearest);
-    }
+    band = std::max(band, pwl::test::farthest_in_band(all.values, leading, margin, &in_band));
     CHECK(leading.size() >= in_band);
     widest = std::max(widest, in_band);
   }

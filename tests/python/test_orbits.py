@@ -69,6 +69,12 @@ def test_continuation_equals_the_cli_files(cli):
     assert [d for d in b["detail"]] == [d for d in np.char.strip(found["detail"].astype(str))]
     assert c.notes and c.parameter_name == "theta"
     assert pwl.continuation is pwl.continue_
+    # Dense: every multiplier known, so the band round the circle is checked as asked.
+    w = c.work
+    assert not w["matrix_free"] and w["monodromies"] > 0 and w["krylov_products"] == 0
+    assert w["narrowest_band"] == 0.05 and w["band_cuts"] >= 0
+    blind = pwl.continue_(figure="4a", parameter="theta", range="0.9:0.95", band=0)
+    assert np.isinf(blind.work["narrowest_band"]) and blind.work["band_cuts"] == 0
 
 
 def test_curves_equal_the_cli_files(cli):

@@ -156,6 +156,24 @@ inline double set_distance(const std::vector<std::complex<double>>& expected,
   return worst;
 }
 
+// The values of `all` (every multiplier, from a formed monodromy) of modulus above 1 − margin,
+// counted into *in_band, and the largest distance from one of them to the nearest of `reported`
+// (0 when there are none): whether a leading set covers the band it was asked for.
+inline double farthest_in_band(const std::vector<std::complex<double>>& all,
+                               const std::vector<std::complex<double>>& reported, double margin,
+                               std::size_t* in_band) {
+  *in_band = 0;
+  double farthest = 0;
+  for (const std::complex<double>& mu : all) {
+    if (std::abs(mu) <= 1.0 - margin) continue;
+    ++*in_band;
+    double nearest = 1e300;
+    for (const std::complex<double>& f : reported) nearest = std::min(nearest, std::abs(f - mu));
+    farthest = std::max(farthest, nearest);
+  }
+  return farthest;
+}
+
 // The Jacobian of φ_{kT} at y by central differences of the map's flow alone (no tangent map), with
 // step h on every component; with `richardson`, the extrapolation (4 D(h/2) − D(h)) / 3, whose
 // error is O(h⁴) instead of O(h²).

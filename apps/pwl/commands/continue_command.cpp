@@ -440,7 +440,8 @@ void continue_orbit(const ContinueFlags& f) {
     }
     if (result.uncovered_bands > 0) {
       fmt::print("  at {} point(s) the multipliers stopped at half their basis still above {:.6g} "
-                 "in modulus: more of them may lie there than were reported\n",
+                 "in modulus: more of them may lie there than were reported, and the band was "
+                 "watched there only as far as they reach\n",
                  result.uncovered_bands, 1.0 - c.shooting.arnoldi.margin);
     }
   } else {
@@ -491,7 +492,7 @@ void continue_orbit(const ContinueFlags& f) {
                  curves.krylov_products, curves.arnoldi_products);
       if (curves.unconverged_multipliers > 0 || curves.uncovered_bands > 0) {
         fmt::print("  at {} corrected point(s) Arnoldi stopped short of its tolerance and at {} it "
-                   "did not reach below every multiplier outside the circle: no fold-, flip- or "
+                   "did not reach below the modulus its margin asks: no fold-, flip- or "
                    "Neimark-Sacker-grazing point is looked for there\n",
                    curves.unconverged_multipliers, curves.uncovered_bands);
       }
@@ -640,6 +641,9 @@ ContinuationProblem continuation_problem(const ContinueFlags& f) {
   curves.method = c.method;
   curves.steps_per_period = c.steps_per_period;
   curves.shooting = c.shooting;  // automatic: matrix-free beyond the dense limit
+  // The branch's margin serves its band; the curves have none, so theirs is their own default
+  // unless --multiplier-margin was given.
+  if (!o.margin_given) curves.shooting.arnoldi.margin = orbits::CurvesOptions{}.shooting.arnoldi.margin;
   curves.profile_samples = c.profile_samples;
   if (!curves.is_valid(&why)) throw InputError("--curves: " + why);
   problem.curves = curves;
@@ -681,8 +685,7 @@ std::vector<orbits::Bifurcation> curve_starts(const ContinuationProblem& problem
 }
 
 void add_continue_flags(CLI::App& command, ContinueFlags& flags) {
-  add_orbit_flags(command, flags.orbit, false);
-  flags.orbit.out = "continuation";
+  add_orbit_flags(command, flags.orbit, false);  // with continue_orbit_flags' defaults
   command.get_option("--out")->default_str("continuation");
   command.get_option("--transient")
       ->description("Guess: the state this many forcing periods after rest, at the start of\n"
@@ -721,7 +724,8 @@ void add_continue_flags(CLI::App& command, ContinueFlags& flags) {
                      "Band round the unit circle watched between points: a step is halved while a\n"
                      "multiplier within half of it of the circle has no partner at its other end,\n"
                      "so that none goes out and back within a step unseen; matrix-free, narrowed\n"
-                     "to what the leading multipliers cover (--multiplier-margin widens it). 0: off")
+                     "to what the leading multipliers cover, where they converged not below\n"
+                     "--multiplier-margin. 0: off")
       ->default_val(0.05)
       ->check(number_check({0.0, 1.0, false, true, "a number in [0, 1)"}, "[0,1)"));
   command.add_option("--corrector", flags.corrector,

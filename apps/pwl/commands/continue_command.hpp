@@ -16,8 +16,17 @@
 
 namespace pwl::app {
 
+// The orbit flags' defaults in pwl continue: the multipliers' margin continuation asks
+// (orbits::kContinuationMargin, the band's least width matrix-free) and the folder.
+inline OrbitFlags continue_orbit_flags() {
+  OrbitFlags f;
+  f.multiplier_margin = orbits::kContinuationMargin;
+  f.out = "continuation";
+  return f;
+}
+
 struct ContinueFlags {
-  OrbitFlags orbit;
+  OrbitFlags orbit = continue_orbit_flags();
   std::string parameter;
   std::string range;
   bool switch_branches = false;

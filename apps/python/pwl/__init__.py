@@ -227,6 +227,12 @@ class ContinuationResult(_Result):
         multiplier (complex, NaN for a grazing), abs_multiplier, detail, located, at_largest_gap,
         to_branch, joined_by (-1 for none), test_value, state (bifurcations, 2n)
     notes: why each branch stopped
+    work: the continuation's counts as a dict: matrix_free (bool), monodromies, integrations,
+        krylov_products (GMRES), multiplier_products, unconverged_multipliers, uncovered_bands
+        (points whose multipliers stopped short of the margin's band), band_cuts (steps halved by
+        the band round the circle), narrowest_band (the narrowest band a step was checked in:
+        narrower than asked where only the leading multipliers were known; inf: none checked),
+        step_cuts
     curves (with curves=(Q, (FROM, TO))): curves.csv as a dict of columns: curve, type, the two
         parameters by name, period, spring (1-based, 0 for none), multiplier (complex), kappa,
         amplitude (rows, n), state (rows, 2n); None without curves=

@@ -317,6 +317,19 @@ py::dict continuation(py::kwargs kwargs) {
   py::list notes;
   for (const std::string& note : result.notes) notes.append(note);
   d["notes"] = notes;
+  // The work and what the band round the circle saw (ContinuationResult's counts).
+  py::dict work;
+  work["matrix_free"] = result.matrix_free;
+  work["monodromies"] = result.monodromies;
+  work["integrations"] = result.integrations;
+  work["krylov_products"] = result.krylov_products;
+  work["multiplier_products"] = result.arnoldi_products;
+  work["unconverged_multipliers"] = result.unconverged_multipliers;
+  work["uncovered_bands"] = result.uncovered_bands;
+  work["band_cuts"] = result.band_cuts;
+  work["narrowest_band"] = result.narrowest_band;
+  work["step_cuts"] = result.step_cuts;
+  d["work"] = work;
   if (problem.curves) {
     add_curves(d, curves, *problem.curves, n);
   } else {

@@ -79,9 +79,9 @@
 // (having turned by at most 0.02 rad), so that a multiplier does not leave the circle and come
 // back (a window of stability or instability shorter than a step, the same signature at both
 // ends) between two points unseen. Matrix-free, the band is narrowed to the moduli the leading
-// multipliers cover at both ends (ShootingOptions::arnoldi.margin asks for more of them, to cover
-// a wider one); BranchWalk::too_long in continuation.cpp says what this rests on and what it does
-// not catch.
+// multipliers cover at both ends, which ShootingOptions::arnoldi.margin asks to be at least 1e-5
+// by default (continuation_shooting_options, below); BranchWalk::too_long in continuation.cpp
+// says what this rests on and what it does not catch.
 #include <complex>
 #include <limits>
 #include <string>
@@ -128,6 +128,28 @@ struct Bifurcation {
   bool located = true;
 };
 
+// The shooting options a continuation starts from: ShootingOptions' own, except that matrix-free
+// the leading multipliers are asked at every point for each one of modulus above 1 − 1e-5
+// (ArnoldiOptions::margin = kContinuationMargin), so that the band watched between two points
+// (ContinuationOptions::band) is never narrowed below 1e-5 where they converged within half their
+// basis (FloquetMultipliers::band_covered), instead of to whatever the leading count happens to
+// reach: 2e-8 in the 1000-mass chain's cascade of Neimark–Sacker points with no margin. Measured
+// 2026-12-02 (2 cores, nothing else running): the 1000-mass chain from θ = 0.605 to 0.575 (`pwl
+// continue --n 1000 --alpha 2 --zeta 0.2 --theta 0.605 --parameter theta --range 0.605:0.575
+// --multiplier-margin M`) with margins 0, 1e-5, 1e-4 and 1e-3: 11227, 10981, 13812 and 18074
+// multiplier products, 56.1, 56.3, 71.1 and 96.9 s, the band narrowed to 1.0e-7, 1.0e-5, 4.9e-4
+// and 3.8e-3, 4, 0, 0 and 0 steps halved, the same 8 Neimark–Sacker points. At 10^4 masses
+// (`pwl continue --n 10000 --alpha 2 --zeta 0.2 --theta 1.5 --parameter theta --range 1.5:1.6
+// --max-points 4`), whose long waves crowd ten times nearer the circle (|μ_k| ≈ 1 − 4e-8 k²):
+// 1e-5 took 31.5 to 38.4 s a warm point (band 2.4e-5, 694 MB); 1e-4, about 100 multipliers in
+// its band, 157 s for the first warm point. Wider bands are the caller's choice at that price.
+inline constexpr double kContinuationMargin = 1e-5;
+inline ShootingOptions continuation_shooting_options() {
+  ShootingOptions s;
+  s.arnoldi.margin = kContinuationMargin;
+  return s;
+}
+
 struct ContinuationOptions {
   analysis::SweepParameter parameter;  // what varies (any parameter of the model)
   double start = 0.0;                  // the branch starts here ...
@@ -158,15 +180,16 @@ struct ContinuationOptions {
   // it in the plane, or in modulus having turned by at most 0.02 rad (see the head of this file).
   // Where only the leading multipliers are known (matrix-free), the band is narrowed to what they
   // cover at both ends: 1 − the smallest modulus reported (ShootingOptions::arnoldi: its count,
-  // and its margin, which asks for more of them). 0: no band; steps are then explained by the
-  // counts at their ends alone.
+  // and its margin, 1e-5 here by default, which asks for every multiplier above 1 − margin). 0:
+  // no band; steps are then explained by the counts at their ends alone.
   double band = 0.05;
   // The method that integrates the map, and its steps per forcing period (fixed grid).
   MethodSettings method{Method::exact};
   int steps_per_period = 200;
   // Period k, tolerance, Newton at the first point; `solver` picks dense or matrix-free (automatic:
-  // by dense_state_limit), and its GMRES and Arnoldi settings are the matrix-free ones.
-  ShootingOptions shooting;
+  // by dense_state_limit), and its GMRES and Arnoldi settings are the matrix-free ones. Its
+  // defaults are ShootingOptions' except the multipliers' margin (continuation_shooting_options).
+  ShootingOptions shooting = continuation_shooting_options();
   bool is_valid(std::string* why) const;
 };
 

@@ -94,7 +94,8 @@ struct ArnoldiOptions {
   // up to half the basis, and the same Krylov-Schur decomposition goes on from its thick restart;
   // FloquetMultipliers::band_covered says whether it got below. 0: every multiplier outside the
   // unit circle. Continuation's band round the circle (ContinuationOptions::band), narrowed to
-  // what the reported multipliers cover, is widened to this margin (continuation.hpp).
+  // what the reported multipliers cover, is not narrowed below this margin where they converged;
+  // continuation asks 1e-5 by default (continuation_shooting_options, continuation.hpp).
   // On the 1000-mass orbit of `pwl bench orbits` (|μ_k| ≈ 1 − 4e-6 k², a crowd of ~480 round the
   // circle; blocks of two, 200 vectors) margins of 0, 1e-4, 1e-3 and 4e-3 took 690, 784, 1036
   // and 1088 products for 6, 12, 48 and 96 multipliers (asked for directly, 32 or 64 take 704 and
