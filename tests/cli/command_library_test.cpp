@@ -247,4 +247,16 @@ TEST_CASE("pwl continue asks its branch for continuation's multiplier margin, it
   const ContinuationProblem zero = problem(branch + " --multiplier-margin 0");
   CHECK(zero.options.shooting.arnoldi.margin == 0.0);
   CHECK_FALSE(zero.curves.has_value());
+
+  // Flags filled in without parsing: a margin other than the default reaches the curves too.
+  ContinueFlags unparsed;
+  unparsed.parameter = "theta";
+  unparsed.range = "1.5:1.6";
+  unparsed.curves = "alpha=4:6";
+  unparsed.orbit.run.figure = "5";
+  unparsed.orbit.multiplier_margin = 0.01;
+  const ContinuationProblem filled = continuation_problem(unparsed);
+  CHECK(filled.options.shooting.arnoldi.margin == 0.01);
+  REQUIRE(filled.curves.has_value());
+  CHECK(filled.curves->shooting.arnoldi.margin == 0.01);
 }

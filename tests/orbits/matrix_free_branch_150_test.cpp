@@ -47,6 +47,7 @@ TEST_CASE("the 150-mass chain's branch is the same matrix-free as dense", "[orbi
   // Every point covered the margin, so the band watched between points was never narrowed below
   // it (only the leading multipliers are known matrix-free; dense, all of them).
   CHECK(free.uncovered_bands == 0);
+  REQUIRE(std::isfinite(free.narrowest_band));  // steps were checked
   CHECK(free.narrowest_band >= margin);
   CHECK(dense.narrowest_band == std::max(o.band, margin));
 

@@ -450,7 +450,8 @@ void continue_orbit(const ContinueFlags& f) {
                result.monodromies, result.integrations, result.step_cuts);
   }
   if (std::isfinite(result.narrowest_band)) {
-    const double asked = std::max(c.band, c.shooting.arnoldi.margin);
+    const double asked =
+        result.matrix_free ? std::max(c.band, c.shooting.arnoldi.margin) : c.band;  // as the core
     fmt::print("band: steps checked for a multiplier within half of {:.6g} of the circle "
                "without a partner at its other end{}; {} step(s) halved\n",
                asked,
@@ -641,9 +642,11 @@ ContinuationProblem continuation_problem(const ContinueFlags& f) {
   curves.method = c.method;
   curves.steps_per_period = c.steps_per_period;
   curves.shooting = c.shooting;  // automatic: matrix-free beyond the dense limit
-  // The branch's margin serves its band; the curves have none, so theirs is their own default
-  // unless --multiplier-margin was given.
-  if (!o.margin_given) curves.shooting.arnoldi.margin = orbits::CurvesOptions{}.shooting.arnoldi.margin;
+  // The branch's default margin serves its band; the curves have none, so they keep their own
+  // default unless another margin is asked (typed, or set in flags filled without parsing).
+  if (o.multiplier_margin == orbits::kContinuationMargin) {
+    curves.shooting.arnoldi.margin = orbits::CurvesOptions{}.shooting.arnoldi.margin;
+  }
   curves.profile_samples = c.profile_samples;
   if (!curves.is_valid(&why)) throw InputError("--curves: " + why);
   problem.curves = curves;
@@ -724,8 +727,8 @@ void add_continue_flags(CLI::App& command, ContinueFlags& flags) {
                      "Band round the unit circle watched between points: a step is halved while a\n"
                      "multiplier within half of it of the circle has no partner at its other end,\n"
                      "so that none goes out and back within a step unseen; matrix-free, narrowed\n"
-                     "to what the leading multipliers cover, where they converged not below\n"
-                     "--multiplier-margin. 0: off")
+                     "to what the leading multipliers cover, not below --multiplier-margin where\n"
+                     "they converged within half their basis. 0: off")
       ->default_val(0.05)
       ->check(number_check({0.0, 1.0, false, true, "a number in [0, 1)"}, "[0,1)"));
   command.add_option("--corrector", flags.corrector,

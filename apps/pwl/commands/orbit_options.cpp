@@ -65,8 +65,8 @@ void add_orbit_flags(CLI::App& c, OrbitFlags& f, bool with_dt) {
   c.add_option("--multiplier-margin", f.multiplier_margin,
                "Krylov: Arnoldi reports every Floquet multiplier of modulus above 1 − this\n"
                "(its count doubles until the smallest is below); 0: those outside the circle.\n"
-               "continue: 1e-5 unless given, so that --band's band is watched at least this wide\n"
-               "(--curves: 0 unless given)")
+               "continue: 1e-5 by default, so that --band's band is watched at least this wide\n"
+               "where they converged within half their basis (--curves: 0 unless another is given)")
       ->check(number_check({0.0, 1.0, false, true, "a number in [0, 1)"}, "[0,1)"));
   c.add_option("--multiplier-method", f.multiplier_method,
                "Krylov: automatic (Davidson preconditioned by the open structure where its damping\n"
@@ -85,10 +85,7 @@ void add_orbit_flags(CLI::App& c, OrbitFlags& f, bool with_dt) {
   c.add_flag("--quiet", f.quiet, "No progress on standard error");
 }
 
-void read_method_given(const CLI::App& c, OrbitFlags& f) {
-  f.method_given = c.count("--method") > 0;
-  f.margin_given = c.count("--multiplier-margin") > 0;
-}
+void read_method_given(const CLI::App& c, OrbitFlags& f) { f.method_given = c.count("--method") > 0; }
 
 OrbitMethod orbit_method(const OrbitFlags& f, const GapStructure& structure, double period) {
   OrbitMethod m;

@@ -23,7 +23,6 @@ struct OrbitFlags {
   int max_iterations = 40;
   int transient = 200;         // forcing periods from rest before the guess is taken
   double multiplier_margin = 0.0;  // Arnoldi reports every multiplier with |μ| > 1 − this
-  bool margin_given = false;   // --multiplier-margin typed (or set by a scene)
   std::string multiplier_method = "automatic";  // Krylov: "automatic" (Davidson where it can) or "arnoldi"
   int gmres_recycle = 10;      // Krylov: vectors GMRES recycles (ShootingOptions::gmres_recycled)
   bool no_precondition = false;  // Krylov: GMRES without the open structure's preconditioner
@@ -38,8 +37,7 @@ struct OrbitFlags {
 // --out and --quiet. --method's default becomes the orbit
 // default (orbit_method).
 void add_orbit_flags(CLI::App& command, OrbitFlags& flags, bool with_dt);
-// To be called from the command's callback: records whether --method and --multiplier-margin
-// were given.
+// To be called from the command's callback: records whether --method was given.
 void read_method_given(const CLI::App& command, OrbitFlags& flags);
 
 // The integrator of an orbit. Without --method: the exact event-driven solver for a structure of

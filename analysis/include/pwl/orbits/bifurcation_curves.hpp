@@ -59,8 +59,9 @@
 // for the resonances on a Neimark–Sacker curve, and the same grazing and Neimark–Sacker–grazing
 // tests as dense. The cusp and the generalised period doubling need the left null vector and are
 // not looked for there (a note says so). Where Arnoldi did not converge or did not reach below
-// every multiplier outside the circle, the multipliers' tests are not evaluated (a note says
-// where), as the branch claims no stability change there.
+// the band of its margin (every multiplier outside the circle with the default margin of 0), the
+// multipliers' tests are not evaluated (a note says where), as the branch claims no stability
+// change there.
 #include <complex>
 #include <string>
 #include <vector>
@@ -149,7 +150,7 @@ struct CurvesResult {
   long krylov_products = 0;
   long arnoldi_products = 0;
   int unconverged_multipliers = 0;  // corrected points (trial points of a location included)
-  int uncovered_bands = 0;          // converged, but not below every multiplier outside the circle
+  int uncovered_bands = 0;          // converged, but not below the band of the margin
 };
 
 // Hooks for writing as the curves grow (every hook optional).

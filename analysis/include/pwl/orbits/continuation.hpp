@@ -64,8 +64,9 @@
 // bordered_krylov.hpp); the tangent is the same bordered solve with the previous tangent as its
 // border; the multipliers are the leading ones by thick-restarted Arnoldi, warm-started from the
 // Ritz vectors of the point before (of the bracket's end, at a bifurcation's trial points), and
-// as many as it takes to have one inside the unit circle, so that every multiplier outside is
-// among them (K. Lust, D. Roose, A. Spence and A. R. Champneys, SIAM J. Sci. Comput. 19 (1998)
+// as many as it takes to have one below 1 − margin (1e-5 by default, continuation_shooting_options
+// below), so that every multiplier outside the unit circle, and every one within the margin of it,
+// is among them (K. Lust, D. Roose, A. Spence and A. R. Champneys, SIAM J. Sci. Comput. 19 (1998)
 // 1188-1209, the Newton–Picard setting of the same idea). Detection and location are the same
 // code: the signature counts the multipliers outside the circle, which the leading set holds, and
 // the test functions det(I ∓ M) are taken over the leading set, whose left-out factors (of
