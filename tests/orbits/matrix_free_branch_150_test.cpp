@@ -50,6 +50,8 @@ TEST_CASE("the 150-mass chain's branch is the same matrix-free as dense", "[orbi
   REQUIRE(std::isfinite(free.narrowest_band));  // steps were checked
   CHECK(free.narrowest_band >= margin);
   CHECK(dense.narrowest_band == std::max(o.band, margin));
+  CHECK(dense.band == o.band);  // dense: the band asked, not widened
+  CHECK(free.band == std::max(o.band, margin));
 
   // The same bifurcations in the same order, each within 1e-8 in θ.
   int neimark_sacker = 0;

@@ -72,7 +72,7 @@ def test_continuation_equals_the_cli_files(cli):
     # Dense: every multiplier known, so the band round the circle is checked as asked.
     w = c.work
     assert not w["matrix_free"] and w["monodromies"] > 0 and w["krylov_products"] == 0
-    assert w["narrowest_band"] == 0.05
+    assert w["narrowest_band"] == 0.05 and w["band"] == 0.05
     assert w["multiplier_products"] == 0 and w["uncovered_bands"] == 0
     blind = pwl.continue_(figure="4a", parameter="theta", range="0.9:0.95", band=0)
     assert np.isinf(blind.work["narrowest_band"]) and blind.work["band_cuts"] == 0

@@ -200,6 +200,10 @@ class Continuer {
           map.state_size(), options_.shooting.dense_state_limit));
     }
     result_.matrix_free = matrix_free_;
+    // Matrix-free the margin asks the leading multipliers to cover a band that wide; dense, every
+    // multiplier is known and the band is the one asked for.
+    result_.band = matrix_free_ ? std::max(options_.band, options_.shooting.arnoldi.margin)
+                                : options_.band;
     chord_ = !matrix_free_ &&
              (options_.corrector == Corrector::chord ||
               (options_.corrector == Corrector::automatic && map.state_size() > kChordAbove));
@@ -375,8 +379,8 @@ class Continuer {
   // Matrix-free: the leading multipliers of the orbit at pt and their Ritz vectors, by Davidson
   // or thick-restarted Arnoldi warm-started from `warm` (a point nearby): at least the options'
   // count, and every one in the band of the options' margin (continuation's default: every one
-  // above 1 − 1e-5, kContinuationMargin). `locating` (a bifurcation's trial point): asked for to kLocateMultipliers,
-  // accepted at the options' tolerance where they stop short of it; where they stop short with
+  // above 1 − 1e-5, kContinuationMargin). `locating` (a bifurcation's trial point): asked for to
+  // kLocateMultipliers, accepted at the options' tolerance where they stop short of it; where they stop short with
   // their band not covered (the count doubles only once converged), asked again at the options'
   // tolerance from the Ritz vectors just found, so that the band is covered as at any point.
   void leading_multipliers(Point& pt, int period, const Eigen::MatrixXcd* warm,
@@ -573,10 +577,7 @@ class Continuer {
     // half the band, is among the other end's; not checked where either end did not converge.
     bool too_long(const Point& from, const Point& to) override {
       if (!(c_.options_.band > 0)) return false;
-      // Matrix-free the margin asks the leading multipliers to cover a band that wide; dense,
-      // every multiplier is known and the band is the one asked for.
-      double band = c_.options_.band;
-      if (c_.matrix_free_) band = std::max(band, c_.options_.shooting.arnoldi.margin);
+      double band = c_.result_.band;
       for (const Point* end : {&from, &to}) {
         if (!end->mu.converged) return false;
         band = std::min(band, detail::watched_band(end->mu));

@@ -450,8 +450,7 @@ void continue_orbit(const ContinueFlags& f) {
                result.monodromies, result.integrations, result.step_cuts);
   }
   if (std::isfinite(result.narrowest_band)) {
-    const double asked =
-        result.matrix_free ? std::max(c.band, c.shooting.arnoldi.margin) : c.band;  // as the core
+    const double asked = result.band;
     fmt::print("band: steps checked for a multiplier within half of {:.6g} of the circle "
                "without a partner at its other end{}; {} step(s) halved\n",
                asked,

@@ -230,7 +230,8 @@ class ContinuationResult(_Result):
     work: the continuation's counts as a dict: matrix_free (bool), monodromies, integrations,
         krylov_products (GMRES), multiplier_products, unconverged_multipliers, uncovered_bands
         (points whose multipliers stopped short of the margin's band), band_cuts (steps halved by
-        the band round the circle), narrowest_band (the narrowest band a step was checked in:
+        the band round the circle), band (the band asked; matrix-free widened to the margin),
+        narrowest_band (the narrowest band a step was checked in:
         narrower than asked where only the leading multipliers were known; inf: none checked),
         step_cuts
     curves (with curves=(Q, (FROM, TO))): curves.csv as a dict of columns: curve, type, the two

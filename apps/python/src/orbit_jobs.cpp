@@ -327,6 +327,7 @@ py::dict continuation(py::kwargs kwargs) {
   work["unconverged_multipliers"] = result.unconverged_multipliers;
   work["uncovered_bands"] = result.uncovered_bands;
   work["band_cuts"] = result.band_cuts;
+  work["band"] = result.band;
   work["narrowest_band"] = result.narrowest_band;
   work["step_cuts"] = result.step_cuts;
   d["work"] = work;

@@ -231,6 +231,8 @@ struct ContinuationResult {
   // the narrowest band a step was checked in (narrower than asked where only the leading
   // multipliers were known; infinity: no step was checked).
   long band_cuts = 0;
+  // The band asked: ContinuationOptions::band, matrix-free widened to ArnoldiOptions::margin.
+  double band = 0.0;
   double narrowest_band = std::numeric_limits<double>::infinity();
   // Steps cut in two because the multipliers' signature changed in a way the events located in
   // them did not explain (several events in one step).
