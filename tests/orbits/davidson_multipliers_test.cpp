@@ -5,8 +5,10 @@
 // chain's is, from a nearby linear operator A0 = S D0 S⁻¹ whose waves sit elsewhere (the open
 // structure's M0: its angles are not the orbit's). Checked: the values to 1e-9, the Ritz vectors
 // as eigenvectors, the band round the circle reported whole or said not to be, every multiplier
-// outside the circle found, the whole space at once, a warm start, and the products against
-// Arnoldi's on the same data.
+// outside the circle found, the whole space at once, a warm start (Davidson's and Arnoldi's, from
+// the real Schur vectors of the Ritz vectors given, themselves checked against a real Schur
+// form), and the products against Arnoldi's on the same data.
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <catch2/catch.hpp>
 #include <complex>
@@ -16,6 +18,8 @@
 
 #include "known_spectra.hpp"
 #include "orbit_cases.hpp"
+#include "orbits/multiplier_sorting.hpp"
+#include "orbits/schur_vectors.hpp"
 #include "pwl/orbits/floquet_multipliers.hpp"
 
 using namespace pwl;
@@ -165,6 +169,7 @@ TEST_CASE("preconditioned Davidson resolves a crowd of long waves in fewer produ
   CHECK(arnoldi.converged);
   CHECK(set_distance(arnoldi.values, found.values) <= 1e-9);
   CHECK(davidson < products);
+  const long arnoldi_cold = products;
 
   // Warm-started from its own Ritz vectors on a nearby operator (the next point of a branch):
   // the same values, in fewer products than from cold.
@@ -182,6 +187,80 @@ TEST_CASE("preconditioned Davidson resolves a crowd of long waves in fewer produ
   for (Complex& mu : scaled) mu *= 1.0 + 1e-7;
   CHECK(set_distance(scaled, warm.values) <= 1e-9);
   CHECK(products < davidson);
+
+  // Arnoldi warm-started the same way (from the Schur vectors of the same Ritz vectors): the
+  // same values, in fewer products than its own cold start.
+  products = 0;
+  const FloquetMultipliers arnoldi_warm =
+      leading_floquet_multipliers(apply_nearby, c.size(), options, &vectors);
+  measured("crowd: Arnoldi's products, warm", static_cast<double>(products));
+  CHECK(arnoldi_warm.converged);
+  CHECK(set_distance(scaled, arnoldi_warm.values) <= 1e-9);
+  CHECK(products < arnoldi_cold);
+}
+
+TEST_CASE("the real Schur vectors of leading eigenvectors span their invariant subspaces in order",
+          "[orbits]") {
+  // A = S D S⁻¹, D: the pair 0.99 e^{±0.3i}, the real 0.98, the pair 0.97 e^{±0.5i}, and 18
+  // pairs in a disc of radius 0.5.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const Index n = 41;
+  Matrix D = Matrix::Zero(n, n);
+  put_pair(D, 0, 0.99, 0.3);
+  D(2, 2) = 0.98;
+  put_pair(D, 3, 0.97, 0.5);
+  for (Index i = 5; i + 1 < n; i += 2) put_pair(D, i, 0.5 * std::abs(u(rng)), 3.0 * u(rng));
+  const Matrix S = pwl::test::random_basis(n, rng);
+  const Matrix A = S * D * S.inverse();
+
+  // The eigenvectors of the five leading values, in the order multipliers are reported (each
+  // conjugate with its own column, as the multiplier solvers return them).
+  Eigen::EigenSolver<Matrix> eig(A);
+  std::vector<Complex> values(eig.eigenvalues().begin(), eig.eigenvalues().end());
+  Eigen::MatrixXcd vectors = eig.eigenvectors();
+  pwl::orbits::detail::sort_multipliers(values, vectors);
+  const Eigen::MatrixXcd leading_five = vectors.leftCols(5);
+
+  const Matrix Q = pwl::orbits::detail::real_schur_vectors(leading_five, 10);
+  REQUIRE(Q.cols() == 5);  // a pair's two columns give two vectors, the real value one
+  CHECK((Q.transpose() * Q - Matrix::Identity(5, 5)).norm() <= 1e-12);
+  const Matrix T = Q.transpose() * A * Q;
+  // Invariant: A Q = Q T.
+  const double invariance = (A * Q - Q * T).norm() / A.norm();
+  measured("Schur vectors: |A Q - Q T| / |A|", invariance);
+  CHECK(invariance <= 1e-12);
+  // Quasi-upper-triangular, 2 x 2 blocks at 0 and 3: the first two columns span the leading
+  // pair's subspace, the first three add the real value's, as a real Schur form's do.
+  double below = 0.0;
+  for (Index j = 0; j < 5; ++j) {
+    for (Index i = j + 1; i < 5; ++i) {
+      if (!((i == 1 && j == 0) || (i == 4 && j == 3))) below = std::max(below, std::abs(T(i, j)));
+    }
+  }
+  measured("Schur vectors: largest entry below T's diagonal blocks", below);
+  CHECK(below <= 1e-12);
+  const auto block_values = [&](Index at) {
+    Eigen::EigenSolver<Matrix> block(T.block(at, at, 2, 2), false);
+    return std::vector<Complex>(block.eigenvalues().begin(), block.eigenvalues().end());
+  };
+  CHECK(set_distance(block_values(0), {std::polar(0.99, 0.3), std::polar(0.99, -0.3)}) <= 1e-12);
+  CHECK(T(2, 2) == Approx(0.98).epsilon(1e-12));
+  CHECK(set_distance(block_values(3), {std::polar(0.97, 0.5), std::polar(0.97, -0.5)}) <= 1e-12);
+
+  // A real multiplier's eigenvector with an imaginary part of rounding size gives one column,
+  // not a second made of the rounding.
+  Eigen::MatrixXcd rounded = leading_five;
+  for (Index i = 0; i < n; ++i) rounded(i, 2) += Complex(0.0, 1e-17 * u(rng));
+  CHECK(pwl::orbits::detail::real_schur_vectors(rounded, 10).cols() == 5);
+
+  // At most `limit` columns, the leading ones; nothing from a non-finite set.
+  const Matrix first_three = pwl::orbits::detail::real_schur_vectors(leading_five, 3);
+  REQUIRE(first_three.cols() == 3);
+  CHECK((first_three - Q.leftCols(3)).norm() <= 1e-14);
+  Eigen::MatrixXcd broken = leading_five;
+  broken(7, 2) = Complex(std::numeric_limits<double>::quiet_NaN(), 0.0);
+  CHECK(pwl::orbits::detail::real_schur_vectors(broken, 10).cols() == 0);
 }
 
 TEST_CASE("preconditioned Davidson reports every multiplier in a band round the circle, or says "

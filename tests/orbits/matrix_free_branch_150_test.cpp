@@ -44,6 +44,11 @@ TEST_CASE("the 150-mass chain's branch is the same matrix-free as dense", "[orbi
   CHECK(free.krylov_products > 0);
   CHECK(free.arnoldi_products > 0);
   CHECK(free.unconverged_multipliers == 0);
+  // The chain's damping is classical: every point's multipliers by Davidson preconditioned by the
+  // open structure (trial points of the locations too), none by Arnoldi; dense, neither.
+  CHECK(free.davidson_points >= static_cast<long>(free.points.size()));
+  CHECK(free.arnoldi_points == 0);
+  CHECK(dense.davidson_points + dense.arnoldi_points == 0);
   // Every point covered the margin, so the band watched between points was never narrowed below
   // it (only the leading multipliers are known matrix-free; dense, all of them).
   CHECK(free.uncovered_bands == 0);

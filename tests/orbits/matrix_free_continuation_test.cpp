@@ -89,16 +89,25 @@ TEST_CASE("with GMRES recycling the matrix-free branch is the same branch", "[or
   const ContinuationResult restarted = follow(chain, start, short_options, ShootingSolver::krylov);
   const ContinuationResult recycled =
       follow(chain, start, recycled_options, ShootingSolver::krylov);
+  // The same space carried to each new operator (the next Newton iterate, the next point) by
+  // forming its image again (ShootingOptions::gmres_reform): the same branch again, on other
+  // products.
+  ContinuationOptions carried_options = recycled_options;
+  carried_options.shooting.gmres_reform = true;
+  const ContinuationResult carried = follow(chain, start, carried_options, ShootingSolver::krylov);
   INFO("GMRES products: 60 vectors " << plain.krylov_products << ", cycles of 4 "
                                      << restarted.krylov_products << ", recycled "
                                      << recycled.krylov_products);
   if (std::getenv("PWL_TEST_VERBOSE") != nullptr) {
-    std::printf("GMRES products: 60 vectors %ld, cycles of 4 %ld, cycles of 4 recycling 2 %ld\n",
+    std::printf("GMRES products: 60 vectors %ld, cycles of 4 %ld, cycles of 4 recycling 2 %ld, "
+                "and carrying them across operators %ld\n",
                 static_cast<long>(plain.krylov_products),
                 static_cast<long>(restarted.krylov_products),
-                static_cast<long>(recycled.krylov_products));
+                static_cast<long>(recycled.krylov_products),
+                static_cast<long>(carried.krylov_products));
   }
   CHECK(recycled.krylov_products != restarted.krylov_products);
+  CHECK(carried.krylov_products != recycled.krylov_products);
   const Bifurcation* a = pwl::test::first_doubling(plain);
   const Bifurcation* b = pwl::test::first_doubling(recycled);
   const Bifurcation* c = pwl::test::first_doubling(restarted);
@@ -110,11 +119,17 @@ TEST_CASE("with GMRES recycling the matrix-free branch is the same branch", "[or
            std::abs(a->parameter - b->parameter));
   CHECK(std::abs(a->parameter - b->parameter) <= 1e-8);
   CHECK(plain.bifurcations.size() == recycled.bifurcations.size());
+  const Bifurcation* d = pwl::test::first_doubling(carried);
+  REQUIRE(d != nullptr);
+  measured("figure 4a: period doubling with the space carried across operators against without",
+           std::abs(a->parameter - d->parameter));
+  CHECK(std::abs(a->parameter - d->parameter) <= 1e-8);
+  CHECK(plain.bifurcations.size() == carried.bifurcations.size());
   // Both branches' points carry one stability on each side of the doubling, the same in both, and
   // it changes there.
-  int kinds[2][2] = {{0, 0}, {0, 0}};  // [run][side]: points stable; −1 unstable; 2 mixed
-  const ContinuationResult* runs[2] = {&plain, &recycled};
-  for (int run = 0; run < 2; ++run) {
+  int kinds[3][2] = {};  // [run][side]: 1 points stable; −1 unstable; 2 mixed
+  const ContinuationResult* runs[3] = {&plain, &recycled, &carried};
+  for (int run = 0; run < 3; ++run) {
     int seen[2][2] = {{0, 0}, {0, 0}};  // [side][stable]
     for (const BranchPoint& pt : runs[run]->points) {
       if (pt.branch != 0 || std::abs(pt.parameter - a->parameter) < 1e-6) continue;
@@ -129,6 +144,8 @@ TEST_CASE("with GMRES recycling the matrix-free branch is the same branch", "[or
   }
   CHECK(kinds[0][0] == kinds[1][0]);
   CHECK(kinds[0][1] == kinds[1][1]);
+  CHECK(kinds[0][0] == kinds[2][0]);
+  CHECK(kinds[0][1] == kinds[2][1]);
   CHECK(kinds[0][0] != 2);
   CHECK(kinds[0][1] != 2);
   CHECK(kinds[0][0] == -kinds[0][1]);

@@ -64,6 +64,13 @@ TEST_CASE("a long chain's period-doubling curve, matrix-free, is the dense one",
   }
   CHECK(r[1].monodromies == 0);
   CHECK(r[1].krylov_products > 0);
+  // Every corrected point's leading multipliers by Davidson preconditioned by the open structure
+  // (classical damping), none by Arnoldi; the dense curve forms the monodromy instead. (The
+  // curve's first point, a row of each direction, is corrected twice: on the curve's equations
+  // with q held, then again after the system's refresh.)
+  CHECK(r[1].davidson_points >= static_cast<int>(r[1].points.size()));
+  CHECK(r[1].arnoldi_points == 0);
+  CHECK(r[0].davidson_points + r[0].arnoldi_points == 0);
   for (const double edge : {1.95, 2.05}) {
     pwl::test::check_same_end(
         r[0], r[1], edge, "100 masses: matrix-free - dense period-doubling curve theta at an edge");

@@ -74,6 +74,8 @@ def test_continuation_equals_the_cli_files(cli):
     assert not w["matrix_free"] and w["monodromies"] > 0 and w["krylov_products"] == 0
     assert w["narrowest_band"] == 0.05 and w["band"] == 0.05
     assert w["multiplier_products"] == 0 and w["uncovered_bands"] == 0
+    assert w["davidson_points"] == 0 and w["arnoldi_points"] == 0
+    assert c.curve_work is None
     blind = pwl.continue_(figure="4a", parameter="theta", range="0.9:0.95", band=0)
     assert np.isinf(blind.work["narrowest_band"]) and blind.work["band_cuts"] == 0
 
@@ -96,6 +98,10 @@ def test_curves_equal_the_cli_files(cli):
     found = read_csv(out / "codim2.csv")
     assert len(c.codim2["type"]) == len(np.atleast_1d(found["type"]))
     assert len(c.curve_ends) == 1 and all(c.curve_ends[0])
+    # Dense curves: the monodromy at every point, no Krylov product and no leading-multiplier solve.
+    cw = c.curve_work
+    assert cw["monodromies"] > 0 and cw["krylov_products"] == 0
+    assert cw["multiplier_products"] == 0 and cw["davidson_points"] == 0 == cw["arnoldi_points"]
     assert "1 curve(s)" in repr(c)
 
 

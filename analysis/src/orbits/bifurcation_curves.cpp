@@ -540,7 +540,8 @@ class CurvesRunner {
   // The curve's point corrected from `guess` with τ · (u − prediction) = 0, completed with its
   // multipliers and its tests. Matrix-free: by Newton–Krylov (twice as many steps as the dense
   // corrector forms Jacobians, as the one-parameter continuation allows), and the leading
-  // multipliers by Arnoldi warm-started from the last accepted point.
+  // multipliers by Davidson or Arnoldi (leading_multipliers.hpp) warm-started from the last
+  // accepted point's.
   std::optional<CurvePt> corrected(const Vector& guess, const Vector& prediction,
                                    const Vector& tau, const Matrix* start, int corrections,
                                    double polish) {
@@ -553,6 +554,8 @@ class CurvesRunner {
       pt.residual = c->residual;
       pt.iterations = c->iterations;
       pt.mu = free_->multipliers(pt.u, warm_.size() > 0 ? &warm_ : nullptr, &pt.ritz);
+      if (pt.mu.method == FloquetMultipliers::Method::davidson) ++result_.davidson_points;
+      if (pt.mu.method == FloquetMultipliers::Method::arnoldi) ++result_.arnoldi_points;
       if (!pt.mu.converged) {
         ++result_.unconverged_multipliers;
       } else if (!pt.mu.band_covered) {

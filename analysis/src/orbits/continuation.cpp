@@ -175,7 +175,7 @@ class Continuer {
   Continuer(const analysis::PointModel& model, const ContinuationOptions& options,
             ContinuationObserver* observer, ContinuationResult& result)
       : model_(model),
-        recycled_(options.shooting.gmres_recycled),
+        recycled_(options.shooting.gmres_recycled, options.shooting.gmres_reform),
         options_(options),
         observer_(observer),
         result_(result) {
@@ -408,6 +408,8 @@ class Continuer {
         pt.mu = detail::leading_multipliers(product, y.size(), arnoldi, open, &found, &pt.ritz);
       }
     }
+    if (pt.mu.method == FloquetMultipliers::Method::davidson) ++result_.davidson_points;
+    if (pt.mu.method == FloquetMultipliers::Method::arnoldi) ++result_.arnoldi_points;
     if (!pt.mu.converged) ++result_.unconverged_multipliers;
     if (pt.mu.converged && !pt.mu.band_covered) ++result_.uncovered_bands;
   }
@@ -1027,8 +1029,9 @@ class Continuer {
   // bifurcation's trial points) closes the orbit further (CorrectorSettings::polish).
   //
   // Matrix-free (beyond the dense limit) the corrector is correct_matrix_free, Newton-Krylov with
-  // `2 * corrections` steps at most, and the multipliers come from Arnoldi warm-started from the
-  // point `near`'s Ritz vectors.
+  // `2 * corrections` steps at most, and the multipliers come from Davidson or Arnoldi
+  // (leading_multipliers.hpp) warm-started from the point `near`'s (its Ritz vectors' real Schur
+  // vectors).
   std::optional<Point> correct_from(const Vector& guess, const Vector& prediction,
                                     const Vector& tau, const Vector& b, int period,
                                     const Matrix* monodromy, int corrections,

@@ -14,6 +14,7 @@
 #include <random>
 
 #include "orbits/multiplier_sorting.hpp"
+#include "orbits/schur_vectors.hpp"
 #include "pwl/errors.hpp"
 #include "pwl/orbits/floquet_multipliers.hpp"
 
@@ -164,21 +165,19 @@ FloquetMultipliers preconditioned_floquet_multipliers(const std::function<void(M
        size}));
   const double edge = 1.0 - options.margin;
 
-  // The start: the warm Ritz vectors' real and imaginary parts, a fixed random vector, and the
-  // preconditioner's (M0 − I)⁻¹ of it, which lifts the modes near 1 (a long chain's long waves).
+  // The start: the warm point's real Schur vectors (schur_vectors.hpp: an orthonormal basis of
+  // the invariant subspace of its leading multipliers, at most half the basis less three), a fixed
+  // random vector, and the preconditioner's (M0 − I)⁻¹ of it, which lifts the modes near 1 (a
+  // long chain's long waves).
   std::mt19937 rng(options.seed);
   std::normal_distribution<double> normal;
   Vector random(size);
   for (Index i = 0; i < size; ++i) random(i) = normal(rng);
   random /= random.norm();
   std::vector<Vector> start;
-  if (warm != nullptr && warm->rows() == size && warm->allFinite()) {
-    for (Index c = 0; c < warm->cols() && static_cast<int>(start.size()) + 2 < m / 2; ++c) {
-      start.emplace_back(warm->col(c).real());
-      if (warm->col(c).imag().norm() > 1e-12 * warm->col(c).norm()) {
-        start.emplace_back(warm->col(c).imag());
-      }
-    }
+  if (warm != nullptr && warm->rows() == size) {
+    const Matrix schur = detail::real_schur_vectors(*warm, std::max(0, m / 2 - 3));
+    for (Index c = 0; c < schur.cols(); ++c) start.emplace_back(schur.col(c));
   }
   start.push_back(random);
   const Eigen::VectorXcd lifted = inverse(random.cast<Complex>(), Complex(1.0, 0.0));

@@ -34,8 +34,8 @@ MatrixFreeBordered::MatrixFreeBordered(PlaneMaps& maps, int period, Index n, dou
       sigma_(type == CurveType::fold ? 1.0 : type == CurveType::period_doubling ? -1.0 : 0.0),
       border_(orthonormal_columns(right)),
       open_(maps, period, p0, q0, 1.0),
-      inner_space_(maps.options().shooting.gmres_recycled),
-      outer_space_(maps.options().shooting.gmres_recycled) {
+      inner_space_(maps.options().shooting.gmres_recycled, maps.options().shooting.gmres_reform),
+      outer_space_(maps.options().shooting.gmres_recycled, maps.options().shooting.gmres_reform) {
   if (type != CurveType::fold) condition_.emplace(maps, period, p0, q0, sigma_);  // NS: set by κ
 }
 

@@ -19,7 +19,8 @@ MatrixFreeGrazing::MatrixFreeGrazing(PlaneMaps& maps, int period, Index n, doubl
                                      double q0)
     : GrazingSystem(maps, period, n, p_scale, q_scale, spring, at_largest),
       MatrixFreeCurve(maps.options().shooting.tolerance),
-      open_(maps, period, p0, q0, 1.0) {}
+      open_(maps, period, p0, q0, 1.0),
+      space_(maps.options().shooting.gmres_recycled, maps.options().shooting.gmres_reform) {}
 
 bool MatrixFreeGrazing::residuals(const Vector& u, Linearised& l) {
   if (last_at_.size() == u.size() && last_at_ == u) {
@@ -103,10 +104,11 @@ bool MatrixFreeGrazing::solve(const Vector& u, const Linearised& l, const Vector
     D << l.gamma_p, l.gamma_q, tau(n_), tau(n_ + 1);
     const detail::BorderedKrylov system(product, open, l.B, C, D, row_known ? 0 : 1);
     Vector x, s;
-    // Recycled across this solve's restarts only: each step is a new operator.
-    detail::RecycledSubspace recycled(shooting.gmres_recycled);
+    // Each step is a new operator: the space is dropped, or its image formed again
+    // (ShootingOptions::gmres_reform).
+    space_.operator_changed();
     system.solve(r, rho, x, s, tolerance, shooting.gmres_dimension, shooting.gmres_restarts,
-                 &recycled);
+                 &space_);
     delta.resize(n_ + 2);
     delta << x, s;
   } catch (const Error&) {

@@ -36,6 +36,7 @@
 #include <optional>
 
 #include "orbits/curve_systems.hpp"
+#include "orbits/gmres.hpp"
 #include "orbits/matrix_free_curve.hpp"
 
 namespace pwl::orbits::curves_detail {
@@ -71,6 +72,9 @@ class MatrixFreeGrazing : public GrazingSystem, public MatrixFreeCurve {
   bool solve(const Vector& u, const Linearised& l, const Vector& tau, const Vector& r,
              const Vector& rho, Vector& delta, double tolerance);
   CurvePreconditioner open_;
+  // GMRES's recycled subspace (gmres.hpp), kept across a solve's restarts and, with
+  // ShootingOptions::gmres_reform, carried from one step's operator to the next.
+  detail::RecycledSubspace space_;
   // The residuals of the last u evaluated (the tangent at a corrected point reuses them).
   Linearised last_;
   Vector last_at_;

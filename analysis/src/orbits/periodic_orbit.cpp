@@ -293,6 +293,7 @@ PeriodicOrbit find_periodic_orbit(StroboscopicMap& map, const Vector& guess,
     orbit.preconditioned = preconditioner && preconditioner->available();
     return orbit;
   };
+  detail::RecycledSubspace recycled(options.gmres_recycled, options.gmres_reform);
   for (int iteration = 0;; ++iteration) {
     if (options.on_iteration) options.on_iteration(iteration, residual, krylov_products);
     if (!F.allFinite()) throw fail("met a non-finite state", residual, iteration);
@@ -320,8 +321,9 @@ PeriodicOrbit find_periodic_orbit(StroboscopicMap& map, const Vector& guess,
     }
     forcing = std::max(forcing, 0.5 * options.tolerance * std::max(1.0, inf_norm(y)) / residual);
     Vector u;
-    // Recycled across this solve's restarts only: the map's derivative changes with the iterate.
-    detail::RecycledSubspace recycled(options.gmres_recycled);
+    // The map's derivative changes with the iterate: the space is dropped, or its image formed
+    // again (ShootingOptions::gmres_reform).
+    recycled.operator_changed();
     const detail::GmresResult g = detail::gmres(apply, -F, u, forcing, options.gmres_dimension,
                                                 options.gmres_restarts, &recycled);
     krylov_products += g.products;

@@ -429,10 +429,11 @@ void continue_orbit(const ContinueFlags& f) {
     for (const std::string& note : result.notes) fmt::print("  {}\n", note);
   }
   if (result.matrix_free) {
-    fmt::print("work (matrix-free): {} GMRES products, {} multiplier products, {} other integrations "
-               "of the map; {} step(s) cut to explain the multipliers' signature\n",
-               result.krylov_products, result.arnoldi_products, result.integrations,
-               result.step_cuts);
+    fmt::print("work (matrix-free): {} GMRES products, {} multiplier products (by Davidson at {} "
+               "point(s), by Arnoldi at {}), {} other integrations of the map; {} step(s) cut to "
+               "explain the multipliers' signature\n",
+               result.krylov_products, result.arnoldi_products, result.davidson_points,
+               result.arnoldi_points, result.integrations, result.step_cuts);
     if (result.unconverged_multipliers > 0) {
       fmt::print("  at {} point(s) the multipliers stopped short of their tolerance: their stability rests on "
                  "unconverged Ritz values\n",
@@ -488,8 +489,10 @@ void continue_orbit(const ContinueFlags& f) {
     fmt::print("curves' work: {} monodromies, {} other integrations of the map\n",
                curves.monodromies, curves.integrations);
     if (curves.krylov_products > 0 || curves.arnoldi_products > 0) {
-      fmt::print("  matrix-free curves: {} GMRES products, {} multiplier products\n",
-                 curves.krylov_products, curves.arnoldi_products);
+      fmt::print("  matrix-free curves: {} GMRES products, {} multiplier products (by Davidson at "
+                 "{} point(s), by Arnoldi at {})\n",
+                 curves.krylov_products, curves.arnoldi_products, curves.davidson_points,
+                 curves.arnoldi_points);
       if (curves.unconverged_multipliers > 0 || curves.uncovered_bands > 0) {
         fmt::print("  at {} corrected point(s) Arnoldi stopped short of its tolerance and at {} it "
                    "did not reach below the modulus its margin asks: no fold-, flip- or "

@@ -78,6 +78,11 @@ void add_orbit_flags(CLI::App& c, OrbitFlags& f, bool with_dt) {
                "(GCRO-DR: the harmonic Ritz vectors of its smallest eigenvalues), below GMRES's 60;\n"
                "0: none")
       ->check(number_check({0.0, 60.0, false, true, "a whole number in [0, 60)"}, "[0,60)"));
+  c.add_flag("--gmres-reform", f.gmres_reform,
+             "Krylov: carry those vectors to a new operator too (the next Newton iterate, the\n"
+             "next point) by forming their image again, --gmres-recycle products each time\n"
+             "(GCRO-DR across a sequence of systems); off by default: on pwl's short,\n"
+             "preconditioned solves it costs more products than it saves");
   c.add_flag("--no-precondition", f.no_precondition,
              "Krylov: GMRES without the open structure's preconditioner (as it runs where the\n"
              "damping is not classical), for comparison");
@@ -218,6 +223,7 @@ orbits::ShootingOptions shooting_options(const OrbitFlags& f) {
   s.arnoldi.method = f.multiplier_method == "arnoldi" ? orbits::ArnoldiOptions::Method::arnoldi
                                                       : orbits::ArnoldiOptions::Method::automatic;
   s.gmres_recycled = f.gmres_recycle;
+  s.gmres_reform = f.gmres_reform;
   s.precondition = !f.no_precondition;
   return s;
 }

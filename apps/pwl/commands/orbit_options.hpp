@@ -25,6 +25,7 @@ struct OrbitFlags {
   double multiplier_margin = 0.0;  // Arnoldi reports every multiplier with |μ| > 1 − this
   std::string multiplier_method = "automatic";  // Krylov: "automatic" (Davidson where it can) or "arnoldi"
   int gmres_recycle = 10;      // Krylov: vectors GMRES recycles (ShootingOptions::gmres_recycled)
+  bool gmres_reform = false;   // Krylov: carried to a new operator (ShootingOptions::gmres_reform)
   bool no_precondition = false;  // Krylov: GMRES without the open structure's preconditioner
   std::string guess_file;      // a state file instead of the transient
   std::string out = "orbit";
@@ -33,9 +34,9 @@ struct OrbitFlags {
 
 // The case flags (add_case_options, without --periods and --skip-periods, which an orbit does not
 // use, and without --dt unless `with_dt`), --period, --newton-tol, --max-iterations, --transient,
-// --guess-file, --multiplier-margin, --multiplier-method, --gmres-recycle, --no-precondition,
-// --out and --quiet. --method's default becomes the orbit
-// default (orbit_method).
+// --guess-file, --multiplier-margin, --multiplier-method, --gmres-recycle, --gmres-reform,
+// --no-precondition, --out and --quiet. --method's default becomes the orbit default
+// (orbit_method).
 void add_orbit_flags(CLI::App& command, OrbitFlags& flags, bool with_dt);
 // To be called from the command's callback: records whether --method was given.
 void read_method_given(const CLI::App& command, OrbitFlags& flags);

@@ -229,7 +229,9 @@ class ContinuationResult(_Result):
     notes: why each branch stopped
     work: the continuation's counts as a dict: matrix_free (bool), monodromies, integrations,
         krylov_products (GMRES), multiplier_products, unconverged_multipliers, uncovered_bands
-        (points whose multipliers stopped short of the margin's band), band_cuts (steps halved by
+        (points whose multipliers stopped short of the margin's band), davidson_points and
+        arnoldi_points (matrix-free points whose multipliers came from Davidson's method
+        preconditioned by the open structure, or from Arnoldi), band_cuts (steps halved by
         the band round the circle), band (the band asked; matrix-free widened to the margin),
         narrowest_band (the narrowest band a step was checked in:
         narrower than asked where only the leading multipliers were known; inf: none checked),
@@ -240,6 +242,9 @@ class ContinuationResult(_Result):
     codim2: codim2.csv as a dict of columns: type, the two parameters by name, curves (the curves
         each point was found on), detail, state; None without curves=
     curve_ends: for each curve, why it ended each way; curve_notes: the curves' notes
+    curve_work: the curves' counts as a dict: monodromies, integrations, krylov_products,
+        multiplier_products, unconverged_multipliers, uncovered_bands, davidson_points,
+        arnoldi_points (as work's); None without curves=
     parameter_name, method, method_default, description
     """
 

@@ -135,6 +135,22 @@ class CurveCheckpoints : public orbits::CurvesObserver {
   Interrupt interrupt_;
 };
 
+// The counts a branch (ContinuationResult) and its curves (CurvesResult) both keep: integrations,
+// Krylov and multiplier products, and how the leading multipliers fared and were found.
+template <class Result>
+py::dict work_counts(const Result& r) {
+  py::dict work;
+  work["monodromies"] = r.monodromies;
+  work["integrations"] = r.integrations;
+  work["krylov_products"] = r.krylov_products;
+  work["multiplier_products"] = r.arnoldi_products;
+  work["unconverged_multipliers"] = r.unconverged_multipliers;
+  work["uncovered_bands"] = r.uncovered_bands;
+  work["davidson_points"] = r.davidson_points;
+  work["arnoldi_points"] = r.arnoldi_points;
+  return work;
+}
+
 // The curves and codimension-two points as dicts of columns, as curves.csv and codim2.csv have
 // them (the parameters by their names; multipliers complex; amplitude and state as rows).
 void add_curves(py::dict& d, const orbits::CurvesResult& r, const orbits::CurvesOptions& o,
@@ -196,6 +212,7 @@ void add_curves(py::dict& d, const orbits::CurvesResult& r, const orbits::Curves
   for (const std::string& note : r.notes) notes.append(note);
   d["curve_ends"] = ends;
   d["curve_notes"] = notes;
+  d["curve_work"] = work_counts(r);
 }
 
 py::dict continuation(py::kwargs kwargs) {
@@ -318,14 +335,8 @@ py::dict continuation(py::kwargs kwargs) {
   for (const std::string& note : result.notes) notes.append(note);
   d["notes"] = notes;
   // The work and what the band round the circle saw (ContinuationResult's counts).
-  py::dict work;
+  py::dict work = work_counts(result);
   work["matrix_free"] = result.matrix_free;
-  work["monodromies"] = result.monodromies;
-  work["integrations"] = result.integrations;
-  work["krylov_products"] = result.krylov_products;
-  work["multiplier_products"] = result.arnoldi_products;
-  work["unconverged_multipliers"] = result.unconverged_multipliers;
-  work["uncovered_bands"] = result.uncovered_bands;
   work["band_cuts"] = result.band_cuts;
   work["band"] = result.band;
   work["narrowest_band"] = result.narrowest_band;
@@ -338,6 +349,7 @@ py::dict continuation(py::kwargs kwargs) {
     d["codim2"] = py::none();
     d["curve_ends"] = py::list();
     d["curve_notes"] = py::list();
+    d["curve_work"] = py::none();
   }
   d["parameter_name"] = problem.parameter.name();
   d["method"] = app::orbit_method_label(problem.method);

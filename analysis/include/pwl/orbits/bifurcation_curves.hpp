@@ -151,6 +151,10 @@ struct CurvesResult {
   long arnoldi_products = 0;
   int unconverged_multipliers = 0;  // corrected points (trial points of a location included)
   int uncovered_bands = 0;          // converged, but not below the band of the margin
+  // Matrix-free curves: corrected points whose leading multipliers came from Davidson's method
+  // preconditioned by the open structure, and from thick-restarted Arnoldi.
+  int davidson_points = 0;
+  int arnoldi_points = 0;
 };
 
 // Hooks for writing as the curves grow (every hook optional).

@@ -62,8 +62,10 @@
 // recorded integration where the integrator records its tangent: the banded switching PIM) and
 // right-preconditioned by the bordered matrix of the open structure (analysis/src/orbits/
 // bordered_krylov.hpp); the tangent is the same bordered solve with the previous tangent as its
-// border; the multipliers are the leading ones by thick-restarted Arnoldi, warm-started from the
-// Ritz vectors of the point before (of the bracket's end, at a bifurcation's trial points), and
+// border; the multipliers are the leading ones by Davidson's method preconditioned by the open
+// structure where its damping is classical, by thick-restarted Arnoldi elsewhere, warm-started
+// from the real Schur vectors of the point before (of the bracket's end, at a bifurcation's
+// trial points), and
 // as many as it takes to have one below 1 − margin (1e-5 by default, continuation_shooting_options
 // below), so that every multiplier outside the unit circle, and every one within the margin of it,
 // is among them (K. Lust, D. Roose, A. Spence and A. R. Champneys, SIAM J. Sci. Comput. 19 (1998)
@@ -222,6 +224,11 @@ struct ContinuationResult {
   long krylov_products = 0;
   long arnoldi_products = 0;
   long unconverged_multipliers = 0;
+  // Matrix-free: the points (a location's trial points included) whose leading multipliers came
+  // from Davidson's method preconditioned by the open structure, and from thick-restarted
+  // Arnoldi (FloquetMultipliers::method; ArnoldiOptions::method says which is taken where).
+  long davidson_points = 0;
+  long arnoldi_points = 0;
   // Matrix-free: the points whose converged multipliers did not reach below the band of
   // ArnoldiOptions::margin within half Arnoldi's basis (more may lie in it, outside the circle
   // with margin 0, than were reported).

@@ -125,12 +125,14 @@ struct ArnoldiOptions {
 // band is reported at once, since each is then exact. Throws InputError for invalid options.
 //
 // Warm start (continuation, where the orbit moves little from one point to the next): `warm`, the
-// Ritz vectors of a nearby operator (size x k, complex), starts the iteration from their sum
-// plus a tenth of the fixed random vector, so that the leading subspace is found again in few
-// products while a multiplier that was not among them (one that grows past them) still has a
-// component to grow from. `vectors` (optional) receives the Ritz vectors of the reported
-// multipliers, column i for values[i], each of unit 2-norm: the eigenvector of a multiplier that
-// crosses −1, for branch switching, and the next warm start.
+// Ritz vectors of a nearby operator (size x k, complex, as `vectors` returns them), gives the real
+// Schur vectors of its leading multipliers (an orthonormal basis of their invariant subspace, in
+// their order), and the iteration starts from their sum plus a tenth of the fixed random vector,
+// so that the leading subspace is found again in few products while a multiplier that was not
+// among them (one that grows past them) still has a component to grow from. `vectors`
+// (optional) receives the Ritz vectors of the reported multipliers, column i for values[i], each
+// of unit 2-norm: the eigenvector of a multiplier that crosses −1, for branch switching, and the
+// next warm start.
 FloquetMultipliers leading_floquet_multipliers(const std::function<void(Matrix&)>& apply,
                                                Index size, const ArnoldiOptions& options = {},
                                                const Eigen::MatrixXcd* warm = nullptr,
@@ -157,8 +159,9 @@ using ShiftedInverse =
 // modulus and needs a basis about as large as the crowd (590–690 products at 1000 masses, no
 // convergence at 3000 or 10^4 in 200 vectors); K(θ)⁻¹ separates them by where they are in the
 // plane, a shift-and-invert by the structure's linear part, so each converges in a few products
-// whatever the crowd. Start: the warm Ritz vectors (real and imaginary parts) when given, a fixed
-// random vector and K(1)⁻¹ of it (the long waves, near 1). Restart at `krylov_dimension` columns
+// whatever the crowd. Start: the warm Ritz vectors' real Schur vectors when given (the basis of
+// their invariant subspace, as for Arnoldi), a fixed random vector and K(1)⁻¹ of it (the long
+// waves, near 1). Restart at `krylov_dimension` columns
 // to the span of the leading Ritz vectors, half the basis. Throws InputError for invalid options.
 FloquetMultipliers preconditioned_floquet_multipliers(const std::function<void(Matrix&)>& apply,
                                                       const ShiftedInverse& inverse, Index size,

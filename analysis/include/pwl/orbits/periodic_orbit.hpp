@@ -68,10 +68,14 @@ struct ShootingOptions {
   // recycling: the harmonic Ritz vectors of its smallest eigenvalues), and from one restart of a
   // solve to the next; 0 for none, fewer than gmres_dimension. It pays where one operator takes
   // several right-hand sides: the matrix-free bifurcation curves' inner solves (on the 1000-mass
-  // chain's Neimark-Sacker curves 26% fewer GMRES products with 10). A new operator (the next
-  // Newton step, the next point) starts afresh: re-forming the space's image there would cost
-  // more products than it saves on these short, preconditioned solves.
+  // chain's Neimark-Sacker curves 26% fewer GMRES products with 10).
   int gmres_recycled = 10;
+  // Krylov: whether those vectors are also carried to a new operator (the next Newton iterate,
+  // the next point of a branch or a curve) by forming their image under it again, `gmres_recycled`
+  // products, as GCRO-DR does for a sequence of systems (gmres.hpp). Off by default: a new
+  // operator starts afresh, since on these short, preconditioned solves the image costs more
+  // products than the deflation saves (analysis/README.md, "Recycled Krylov subspaces").
+  bool gmres_reform = false;
   // Krylov: the largest relative residual GMRES is asked for in a Newton step (η_max of
   // Eisenstat and Walker's forcing terms, their 0.9). The forcing starts at 1e-2 and tightens as
   // Newton converges; far from the orbit it may loosen up to this. On the 1000-mass chain of
