@@ -56,25 +56,24 @@
 // followed like the first.
 //
 // Matrix-free continuation. Up to ShootingOptions::dense_state_limit state components (or with
-// solver = dense) continuation forms the monodromy as above. Beyond it (or with solver = krylov)
-// it never does: the corrector is Newton–Krylov on the bordered system [M − I, ∂F/∂p; τᵀ], solved
-// by GMRES on products M v (tangent integrations of the map from the iterate, replayed from its
+// solver = dense) continuation forms the monodromy as above. Beyond it (or with solver = krylov) it
+// never does: the corrector is Newton–Krylov on the bordered system [M − I, ∂F/∂p; τᵀ], solved by
+// GMRES on products M v (tangent integrations of the map from the iterate, replayed from its
 // recorded integration where the integrator records its tangent: the banded switching PIM) and
 // right-preconditioned by the bordered matrix of the open structure (analysis/src/orbits/
 // bordered_krylov.hpp); the tangent is the same bordered solve with the previous tangent as its
 // border; the multipliers are the leading ones by Davidson's method preconditioned by the open
-// structure where its damping is classical, by thick-restarted Arnoldi elsewhere, warm-started
-// from the real Schur vectors of the point before (of the bracket's end, at a bifurcation's
-// trial points), and
-// as many as it takes to have one below 1 − margin (1e-5 by default, continuation_shooting_options
-// below), so that every multiplier outside the unit circle, and every one within the margin of it,
-// is among them (K. Lust, D. Roose, A. Spence and A. R. Champneys, SIAM J. Sci. Comput. 19 (1998)
-// 1188-1209, the Newton–Picard setting of the same idea). Detection and location are the same
-// code: the signature counts the multipliers outside the circle, which the leading set holds, and
-// the test functions det(I ∓ M) are taken over the leading set, whose left-out factors (of
-// multipliers inside the circle) are all positive, so their sign changes exactly where the whole
-// determinant's does. Branch switching takes the Ritz vector of the multiplier −1. The chord
-// corrector is dense only.
+// structure where its damping is classical, by thick-restarted Arnoldi elsewhere, warm-started from
+// the real Schur vectors of the point before (of the bracket's end, at a bifurcation's trial
+// points), and as many as it takes to have one below 1 − margin (1e-5 by default,
+// continuation_shooting_options below), so that every multiplier outside the unit circle, and every
+// one within the margin of it, is among them (K. Lust, D. Roose, A. Spence and A. R. Champneys,
+// SIAM J. Sci. Comput. 19 (1998) 1188-1209, the Newton–Picard setting of the same idea). Detection
+// and location are the same code: the signature counts the multipliers outside the circle, which
+// the leading set holds, and the test functions det(I ∓ M) are taken over the leading set, whose
+// left-out factors (of multipliers inside the circle) are all positive, so their sign changes
+// exactly where the whole determinant's does. Branch switching takes the Ritz vector of the
+// multiplier −1. The chord corrector is dense only.
 //
 // A band round the circle (ContinuationOptions::band, 0.05 unless set; dense or matrix-free): a
 // step is halved while a multiplier within half the band of the circle at one end has no partner

@@ -161,8 +161,8 @@ using ShiftedInverse =
 // plane, a shift-and-invert by the structure's linear part, so each converges in a few products
 // whatever the crowd. Start: the warm Ritz vectors' real Schur vectors when given (the basis of
 // their invariant subspace, as for Arnoldi), a fixed random vector and K(1)⁻¹ of it (the long
-// waves, near 1). Restart at `krylov_dimension` columns
-// to the span of the leading Ritz vectors, half the basis. Throws InputError for invalid options.
+// waves, near 1). Restart at `krylov_dimension` columns to the span of the leading Ritz vectors,
+// half the basis. Throws InputError for invalid options.
 FloquetMultipliers preconditioned_floquet_multipliers(const std::function<void(Matrix&)>& apply,
                                                       const ShiftedInverse& inverse, Index size,
                                                       const ArnoldiOptions& options = {},
